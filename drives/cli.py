@@ -1,0 +1,150 @@
+"""Commands of the drives package: ``eroad data check``, ``eroad data figures``,
+``eroad synth``.
+
+Heavy imports (Exudyn, matplotlib) happen inside the command functions so that
+``eroad --help`` and ``eroad data check`` stay fast.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+
+def register(subparsers) -> None:
+    """Add ``data`` and ``synth`` to the ``eroad`` command line.
+
+    Parameters
+    ----------
+    subparsers : argparse._SubParsersAction
+        The top-level subparsers of ``eroad``.
+    """
+    data = subparsers.add_parser(
+        "data", help="measured datasets: check one, plot Figures 4-5",
+        description="Work with measurement datasets (channels.csv + meta.toml; see "
+        "docs/measurement.md).")
+    dsub = data.add_subparsers(dest="data_command", metavar="ACTION")
+    data.set_defaults(func=lambda a: _help(data))
+
+    chk = dsub.add_parser(
+        "check", help="validate a dataset and print a summary",
+        description="Validate DATASET against the measurement-format contract. Prints a "
+        "summary (duration, rate, channels, speed range), or one line per problem naming "
+        "file, column and row with exit code 2. Reads nothing in truth/ and writes nothing.")
+    chk.add_argument("dataset", metavar="DATASET", help="dataset folder")
+    chk.add_argument("--json", action="store_true", help="print the summary (or problems) as JSON")
+    chk.set_defaults(func=cmd_check)
+
+    fig = dsub.add_parser(
+        "figures", help="Figures 4 and 5: axle-3-left suspension displacement and spectra",
+        description="Figure 4: third-axle left suspension displacement over the whole record "
+        "with the selected window marked, and the window alone. Figure 5: its spectrum "
+        "(Welch PSD) before and after slicing. Writes PNG and PDF, and summary.json.")
+    fig.add_argument("dataset", metavar="DATASET", help="dataset folder")
+    fig.add_argument("--out", required=True, metavar="DIR", help="output folder (new or empty)")
+    fig.add_argument("--window", nargs=2, type=float, metavar=("T0", "T1"), default=None,
+                     help="window [s] in the time column (default: the whole record)")
+    fig.add_argument("--channel", default="susp_disp_3L",
+                     help="channel to plot (default: susp_disp_3L)")
+    fig.add_argument("--force", action="store_true", help="replace a non-empty --out")
+    fig.add_argument("--json", action="store_true", help="print summary.json")
+    fig.set_defaults(func=cmd_figures)
+
+    syn = subparsers.add_parser(
+        "synth", help="virtual test drive: a 'measured' dataset from a known truth",
+        description="Make a measurement dataset from a known truth (road segments, speed "
+        "profile, truth vehicle with effects, sensor noise); everything used goes to "
+        "OUT/truth/. Scenarios: luliang (the paper's 460-490 s window, the embedded "
+        "default), random (seed draws the road and speed), null (truth vehicle = nominal "
+        "model), or a TOML file with --config. Same seed, same bytes.",
+        epilog="Example: eroad synth --scenario luliang --seed 0 --out luliang-0")
+    syn.add_argument("--scenario", default=None,
+                     help="luliang | random | null (default luliang, or from --config)")
+    syn.add_argument("--seed", type=int, default=None, help="root seed (default 0)")
+    syn.add_argument("--effect", action="append", default=[], metavar="NAME=VALUE",
+                     help="add an effect to the truth vehicle, e.g. leaf_friction=1.5 or "
+                     "payload.mass_kg=2000 (repeatable; 'eroad effects' lists them)")
+    syn.add_argument("--no-default-effects", action="store_true",
+                     help="drop the scenario's own effects (keep only --effect ones)")
+    syn.add_argument("--vehicle", default=None,
+                     help="built-in vehicle id or vehicle TOML file (default per scenario)")
+    syn.add_argument("--duration", type=float, default=None, help="record length [s]")
+    syn.add_argument("--config", default=None, metavar="TOML",
+                     help="scenario TOML setting everything explicitly (see "
+                     "drives/scenarios/luliang.toml)")
+    syn.add_argument("--out", required=True, metavar="DIR", help="dataset folder to create")
+    syn.add_argument("--force", action="store_true", help="replace a non-empty --out")
+    syn.add_argument("--json", action="store_true", help="print summary.json")
+    syn.set_defaults(func=cmd_synth)
+
+
+def _help(parser: argparse.ArgumentParser) -> int:
+    parser.print_help()
+    return 2
+
+
+def format_summary(s: dict) -> str:
+    """Human-readable lines for a :meth:`drives.format.Drive.summary` dict."""
+    lines = [
+        f"dataset   {s['name']}: valid",
+        f"duration  {s['duration_s']:.3f} s ({s['n_samples']} samples, "
+        f"t = {s['t_start_s']:g} .. {s['t_end_s']:g} s)",
+        f"rate      {s['sample_rate_hz']:g} Hz",
+        f"channels  {len(s['channels'])}: {', '.join(s['channels'])}",
+        f"speed     {s['speed_min_mps']:.3f} .. {s['speed_max_mps']:.3f} m/s "
+        f"({'speed column' if s['speed_source'] == 'column' else 'constant from meta.toml'})",
+        f"vehicle   {s['vehicle']}{' (file in the dataset)' if s['vehicle_is_file'] else ''}",
+    ]
+    return "\n".join(lines)
+
+
+def cmd_check(args) -> int:
+    """``eroad data check DATASET``: 0 if valid, 2 with one line per problem."""
+    from drives.format import inspect_drive
+
+    problems, drive = inspect_drive(args.dataset)
+    if problems:
+        if args.json:
+            print(json.dumps({"valid": False, "problems": problems}, indent=2))
+        else:
+            for p in problems:
+                print(f"eroad: error: {p}", file=sys.stderr)
+            print(f"eroad: {len(problems)} problem(s); the dataset breaks the contract "
+                  "(docs/measurement.md)", file=sys.stderr)
+        return 2
+    s = {"valid": True, **drive.summary()}
+    print(json.dumps(s, indent=2) if args.json else format_summary(s))
+    return 0
+
+
+def cmd_figures(args) -> int:
+    """``eroad data figures DATASET --out DIR``."""
+    from drives.figures import figures_command
+
+    summary = figures_command(args.dataset, args.out, window=args.window,
+                              channel=args.channel, force=args.force)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        for f in summary["files"]:
+            print(f)
+    return 0
+
+
+def cmd_synth(args) -> int:
+    """``eroad synth ...``."""
+    from drives.synth import synth_command
+
+    summary = synth_command(scenario=args.scenario, seed=args.seed, effects=args.effect,
+                            vehicle=args.vehicle, duration=args.duration, config=args.config,
+                            out=args.out, force=args.force,
+                            default_effects=not args.no_default_effects)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(f"wrote {summary['out']}: {summary['duration_s']:g} s at "
+              f"{summary['sample_rate_hz']:g} Hz, {len(summary['channels'])} channels, "
+              f"{len(summary['segments'])} road segments, seed {summary['seed']} "
+              f"({summary['wall_s']:.1f} s wall)")
+    return 0
+

@@ -1,0 +1,211 @@
+"""Spectral road parameters as the inverse fit sees them: layout, bounds, classes, grid.
+
+What it is for: one place that says how the per-segment road parameters are laid
+out in arrays, how they map to the fit's log-parameters, which bounds the fit
+respects, which ISO 8608 class a level belongs to, and which road grid (dx, dy) a
+fitted band implies.  What it is not: a road generator (``roadlib.synthesis``) or
+the PSD library (``roadlib.psd``).
+
+Layout
+------
+Physical parameters of K segments are an array ``params`` of shape (K, 4) with
+columns ``PARAM_NAMES = ("Gq_n0", "w", "nmin", "nmax")``:
+
+* ``Gq_n0`` [m^3]   one-sided displacement PSD at n0 = 0.1 cycles/m (ISO 8608),
+* ``w`` [-]         waviness, Gd(n) = Gq_n0 (n / n0)^-w,
+* ``nmin`` [cycles/m], ``nmax`` [cycles/m]  band of the harmonic synthesis.
+
+The fit works in ``theta`` (same shape) with columns
+``THETA_NAMES = ("ln_Gq_n0", "w", "ln_nmin", "ln_nmax")``: level and band edges in
+natural logarithms (a factor, not a difference, is what the data resolve), ``w``
+as is.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from eroad.errors import EroadInputError
+
+#: reference spatial frequency of ISO 8608 [cycles/m]
+N0 = 0.1
+
+#: column names of a (K, 4) physical parameter array
+PARAM_NAMES = ("Gq_n0", "w", "nmin", "nmax")
+#: units of the physical parameters
+PARAM_UNITS = ("m^3", "-", "cycles/m", "cycles/m")
+#: column names of the fit's (K, 4) log-parameter array
+THETA_NAMES = ("ln_Gq_n0", "w", "ln_nmin", "ln_nmax")
+
+#: ISO 8608 road classes: geometric mean of Gd(n0) [m^3] (Table 1 of the standard;
+#: class A 16e-6 m^3, each class a factor 4 above the previous one; the class
+#: bounds lie a factor 2 either side).  Mirrors ``roadlib.psd.ISO_CLASSES``.
+ISO_CLASS_GD0 = {c: 16e-6 * 4.0 ** i for i, c in enumerate("ABCDEFGH")}
+
+
+def iso_class(Gq_n0: float) -> str:
+    """ISO 8608 class of a displacement PSD level.
+
+    Parameters
+    ----------
+    Gq_n0 : float
+        Gd(n0) [m^3], one-sided, n0 = 0.1 cycles/m.
+
+    Returns
+    -------
+    str
+        'A' ... 'H': the class whose geometric mean is nearest in log, which is the
+        class whose bounds (a factor 2 either side of the mean) contain ``Gq_n0``.
+        Levels beyond H are reported as 'H', below A as 'A'.
+    """
+    if not (Gq_n0 > 0 and math.isfinite(Gq_n0)):
+        raise EroadInputError(f"iso_class: Gq_n0 must be a positive number, got {Gq_n0!r}")
+    names = list(ISO_CLASS_GD0)
+    logs = np.log([ISO_CLASS_GD0[c] for c in names])
+    return names[int(np.argmin(np.abs(logs - math.log(Gq_n0))))]
+
+
+def params_to_theta(params) -> np.ndarray:
+    """Physical (K, 4) parameters [Gq_n0 m^3, w, nmin, nmax cycles/m] -> fit's theta.
+
+    Parameters
+    ----------
+    params : array_like, shape (K, 4) or (4,)
+
+    Returns
+    -------
+    ndarray, shape (K, 4)
+        Columns ln Gq_n0 [ln m^3], w [-], ln nmin, ln nmax [ln cycles/m].
+    """
+    p = np.atleast_2d(np.asarray(params, dtype=float))
+    if p.shape[1] != 4:
+        raise EroadInputError(f"params must have 4 columns {PARAM_NAMES}, got shape {p.shape}")
+    if np.any(p[:, [0, 2, 3]] <= 0):
+        raise EroadInputError("params: Gq_n0, nmin and nmax must be positive")
+    th = p.copy()
+    th[:, [0, 2, 3]] = np.log(p[:, [0, 2, 3]])
+    return th
+
+
+def theta_to_params(theta) -> np.ndarray:
+    """Inverse of :func:`params_to_theta`; returns a new (K, 4) array."""
+    th = np.atleast_2d(np.asarray(theta, dtype=float))
+    p = th.copy()
+    p[:, [0, 2, 3]] = np.exp(th[:, [0, 2, 3]])
+    return p
+
+
+@dataclass(frozen=True)
+class ParamBounds:
+    """Bounds of the per-segment fit, from the road classes and from physics.
+
+    Parameters
+    ----------
+    Gq_n0 : (float, float)
+        [m^3].  Default 1e-6 to 4.096e-3: from well below class A to the upper
+        bound of class F (the classes a truck drives at speed).
+    w : (float, float)
+        [-].  Default 1.2 to 3.0: measured roads lie around 2 (ISO 8608 annex;
+        published fits 1.5-2.5); outside that range the "road" is a different kind
+        of object (a ramp, white noise).
+    nmin : (float, float)
+        [cycles/m].  Default 0.005 (200 m wavelength) to 0.2 (5 m).
+    nmax : (float, float)
+        [cycles/m].  Default 1 (1 m wavelength) to 10 (0.1 m, about a tyre contact
+        length); :meth:`for_record` lowers the top to the temporal Nyquist limit.
+    min_ratio : float
+        Smallest nmax / nmin [-]; default 5, so the band is never empty.
+    """
+
+    Gq_n0: tuple = (1e-6, 4.096e-3)
+    w: tuple = (1.2, 3.0)
+    nmin: tuple = (0.005, 0.2)
+    nmax: tuple = (1.0, 10.0)
+    min_ratio: float = 5.0
+
+    def __post_init__(self):
+        for name in PARAM_NAMES:
+            lo, hi = getattr(self, name)
+            if not (lo < hi):
+                raise EroadInputError(f"ParamBounds.{name}: lower {lo} must be below upper {hi}")
+        if self.Gq_n0[0] <= 0 or self.nmin[0] <= 0 or self.nmax[0] <= 0:
+            raise EroadInputError("ParamBounds: Gq_n0, nmin and nmax bounds must be positive")
+        if self.min_ratio <= 1:
+            raise EroadInputError("ParamBounds.min_ratio must exceed 1")
+        if self.nmax[1] / self.nmin[0] < self.min_ratio:
+            raise EroadInputError("ParamBounds: nmax upper / nmin lower is below min_ratio")
+
+    def for_record(self, fs: float, v_max: float) -> "ParamBounds":
+        """Bounds with nmax capped at the temporal Nyquist limit fs / (2 v_max).
+
+        Parameters
+        ----------
+        fs : float
+            Sample rate of the measured record [Hz].
+        v_max : float
+            Highest speed in the record [m/s].
+
+        Returns
+        -------
+        ParamBounds
+            Road content above fs / (2 v_max) [cycles/m] would alias in the
+            measurement, so the data cannot speak for it.
+        """
+        cap = fs / (2.0 * v_max)
+        hi = min(self.nmax[1], cap)
+        lo = min(self.nmax[0], 0.5 * hi)
+        return ParamBounds(self.Gq_n0, self.w, self.nmin, (lo, hi), self.min_ratio)
+
+    def theta_lower(self) -> np.ndarray:
+        """Lower bounds of theta, shape (4,)."""
+        return np.array([math.log(self.Gq_n0[0]), self.w[0],
+                         math.log(self.nmin[0]), math.log(self.nmax[0])])
+
+    def theta_upper(self) -> np.ndarray:
+        """Upper bounds of theta, shape (4,)."""
+        return np.array([math.log(self.Gq_n0[1]), self.w[1],
+                         math.log(self.nmin[1]), math.log(self.nmax[1])])
+
+    def clip_theta(self, theta) -> np.ndarray:
+        """Project theta (K, 4) into the bounds, including nmax / nmin >= min_ratio."""
+        th = np.clip(np.atleast_2d(np.asarray(theta, float)), self.theta_lower(), self.theta_upper())
+        gap = math.log(self.min_ratio)
+        low = th[:, 3] - th[:, 2] < gap
+        th[low, 2] = np.maximum(th[low, 3] - gap, math.log(self.nmin[0]))
+        th[low, 3] = th[low, 2] + gap
+        return th
+
+
+#: grid steps the road grid is rounded down to [m]
+_NICE_STEPS = (0.005, 0.01, 0.0125, 0.02, 0.025, 0.05, 0.1, 0.125, 0.2, 0.25, 0.5, 1.0)
+
+
+def grid_spacing(nmax: float, points_per_wavelength: float = 4.0) -> float:
+    """Road grid step dx = dy [m] for a synthesis band that ends at ``nmax``.
+
+    The largest step of (0.005, 0.01, 0.0125, 0.02, 0.025, 0.05, 0.1, ...) m not above
+    1 / (points_per_wavelength * nmax).  With the default 4 points per shortest
+    wavelength a bilinear read-out keeps the amplitude at nmax within
+    sinc^2(1/4) = 0.81 and everything below 0.5 nmax within 5%; 2 points
+    (dx = 1 / (2 nmax), the Nyquist step) would halve it (sinc^2(1/2) = 0.41).
+    The lateral step dy is taken equal to dx (an isotropic grid).
+
+    Parameters
+    ----------
+    nmax : float
+        Highest spatial frequency of the synthesis [cycles/m].
+    points_per_wavelength : float
+        Grid points per shortest wavelength 1 / nmax, >= 2.
+
+    Returns
+    -------
+    float
+        dx [m].
+    """
+    if not (nmax > 0) or points_per_wavelength < 2:
+        raise EroadInputError("grid_spacing: nmax must be positive and points_per_wavelength >= 2")
+    limit = 1.0 / (points_per_wavelength * nmax)
+    fitting = [s for s in _NICE_STEPS if s <= limit * (1 + 1e-12)]
+    return max(fitting) if fitting else limit

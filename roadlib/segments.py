@@ -1,0 +1,245 @@
+"""Roads made of segments with different spectra, with smoothed junctions (eq (8)).
+
+What this module is for: concatenating road segments with different ISO 8608
+parameters along x, in given proportions, and removing the height step at each
+junction with Gaussian-windowed cosine patches (the paper's eq (8), in its
+intended form).  What it is not: the spectral synthesis itself
+(``roadlib.synthesis``) or the road container (``roadlib.surface``).
+
+Junction patches (docs/roadlib.md has the reasoning)
+----------------------------------------------------
+Segment s is synthesised on its own x range with its own phase stream
+``SeedSequence(seed, spawn_key=(s,))``.  Junction j sits half-way between two
+grid samples, at x_j; the independent fields on its two sides differ there by
+d(y) = z_right(x_j, y) - z_left(x_j, y) (both evaluated exactly).  The patched
+surface is::
+
+    z + sum_j sum_m  +-a_jm exp(-(x-x_j)^2/(2 sx_j^2) - (y-y_m)^2/(2 sy^2)) cos(2 pi n_j (x - x_j))
+
+with ``+`` on the left of x_j and ``-`` on the right, so both sides meet at the
+mean (z_left + z_right)/2 and the step disappears.
+
+- y_m: every lateral grid line; sy = dy/2; the a_jm solve the small Gaussian
+  system  sum_m a_jm exp(-(y_i-y_m)^2/(2 sy^2)) = d(y_i)/2  so the correction is
+  exactly d/2 on every grid line (A_j in the issue's notation is a_jm).
+- sx_j: the smallest width for which the patch's own largest step along x is at
+  most half the median step of the unpatched field,
+  sx_j = c_h max|d|/2 dx / (0.5 median|dz|), with c_h = max |h'(u)| sx of the
+  window shape h; at least 10 dx, at most a third of the shorter neighbouring
+  segment (the patch must not reach the next junction).
+- n_j = 1 / (12 sx_j): the cosine's first zero falls on |x - x_j| = 3 sx_j, where
+  the window is cut off, so the finite support adds no step of its own.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from eroad.errors import EroadInputError
+from roadlib.psd import ISO_BAND, class_gd0
+from roadlib.synthesis import SpectralParams, _grid_count, _lateral_axis, harmonic_field
+
+#: patch window support in units of sx (the cosine is zero there)
+PATCH_SUPPORT = 3.0
+#: the patch's largest step is at most this fraction of the field's median step
+PATCH_STEP_FRACTION = 0.5
+#: lateral patch width as a fraction of dy
+PATCH_SY_OVER_DY = 0.5
+
+
+def _window(u, sx):
+    """Patch shape h(u) = exp(-u^2/(2 sx^2)) cos(2 pi u / (12 sx)), zero for |u| > 3 sx."""
+    u = np.asarray(u, float)
+    h = np.exp(-0.5 * (u / sx) ** 2) * np.cos(2.0 * np.pi * u / (4.0 * PATCH_SUPPORT * sx))
+    return np.where(np.abs(u) <= PATCH_SUPPORT * sx, h, 0.0)
+
+
+def _window_slope_constant() -> float:
+    u = np.linspace(0.0, PATCH_SUPPORT, 20001)
+    h = _window(u, 1.0)
+    return float(np.max(np.abs(np.gradient(h, u))))
+
+
+#: max |h'(u)| * sx of the window shape (dimensionless, about 0.69)
+WINDOW_SLOPE = _window_slope_constant()
+
+
+@dataclass(frozen=True)
+class RoadSegment:
+    """One road segment: its spectrum and its share of the road length.
+
+    Parameters
+    ----------
+    Gq_n0 : float
+        Displacement PSD level Gd(n0) [m^3].
+    share : float
+        Relative length [-] (any positive number; the segment gets
+        ``share / sum(shares)`` of the road length).  Giving lengths in metres
+        as shares with the road length equal to their sum gives exact lengths.
+    w : float
+        Waviness [-].
+    nmin, nmax : float
+        Synthesis band [cycles/m].
+    lam : float
+        Anisotropy factor [-] (eq (5)).
+    label : str
+        Free name (e.g. the ISO class letter).
+    """
+
+    Gq_n0: float
+    share: float = 1.0
+    w: float = 2.0
+    nmin: float = ISO_BAND[0]
+    nmax: float = ISO_BAND[1]
+    lam: float = 1.0
+    label: str = ""
+
+    def __post_init__(self):
+        try:
+            share = float(self.share)
+        except (TypeError, ValueError):
+            raise EroadInputError(f"RoadSegment.share must be a number, got {self.share!r}") from None
+        if not (math.isfinite(share) and share > 0):
+            raise EroadInputError(f"RoadSegment.share must be positive, got {self.share!r}")
+        object.__setattr__(self, "share", share)
+
+    @classmethod
+    def from_class(cls, name: str, share: float = 1.0, **kw) -> "RoadSegment":
+        """Segment with the geometric-mean level of ISO class ``name``."""
+        kw.setdefault("label", str(name).strip().upper())
+        return cls(Gq_n0=class_gd0(name), share=share, **kw)
+
+    def params(self, dx: float, dy: float) -> SpectralParams:
+        """The segment's :class:`SpectralParams` on a grid dx, dy [m] (validates)."""
+        try:
+            return SpectralParams(Gq_n0=self.Gq_n0, w=self.w, nmin=self.nmin, nmax=self.nmax,
+                                  dx=dx, dy=dy, lam=self.lam)
+        except EroadInputError as exc:
+            raise EroadInputError(f"segment {self.label or ''}: {exc}".replace("segment : ", "segment: ")) from None
+
+    def to_dict(self) -> dict:
+        return {"Gq_n0": self.Gq_n0, "share": self.share, "w": self.w, "nmin": self.nmin,
+                "nmax": self.nmax, "lam": self.lam, "label": self.label}
+
+
+def _solve_lateral(y: np.ndarray, target: np.ndarray, sy: float) -> np.ndarray:
+    if y.size == 1:
+        return target.copy()
+    g = np.exp(-0.5 * ((y[:, None] - y[None, :]) / sy) ** 2)
+    return np.linalg.solve(g, target)
+
+
+def segmented_surface(segments, length: float, width: float, dx: float, dy: float,
+                      seed=0, x0: float = 0.0):
+    """Road of consecutive segments along x with patched junctions.
+
+    Parameters
+    ----------
+    segments : sequence of RoadSegment
+        In travel order; lengths in proportion to their ``share``.
+    length : float
+        Road length [m].
+    width : float
+        Road width [m], centred on y = 0 (0 gives a single track).
+    dx, dy : float
+        Grid spacing [m].
+    seed : int
+        Root seed; segment s uses ``SeedSequence(seed, spawn_key=(s,))``.
+    x0 : float
+        Start position [m].
+
+    Returns
+    -------
+    RoadSurface
+        ``meta`` lists the segments (start, end [m]), the junctions (x_j [m],
+        sx [m], n_j [cycles/m], sy [m], largest step across the junction [m]),
+        the field's median step [m], the seed.
+
+    Raises
+    ------
+    EroadInputError
+        No segments, a segment shorter than 2 samples, a bad parameter.
+    """
+    from roadlib.surface import RoadSurface
+
+    segments = list(segments)
+    if not segments:
+        raise EroadInputError("segmented_surface: no segments given")
+    for i, s in enumerate(segments):
+        if not isinstance(s, RoadSegment):
+            raise EroadInputError(f"segmented_surface: segment {i} is a {type(s).__name__}, not a RoadSegment")
+    if not (isinstance(seed, (int, np.integer)) and seed >= 0):
+        raise EroadInputError(f"seed must be a non-negative integer, got {seed!r}")
+    for name, v in (("dx", dx), ("dy", dy)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            raise EroadInputError(f"grid spacing {name} must be a positive number of metres, got {v!r}")
+    params = [s.params(dx, dy) for s in segments]
+    nx = _grid_count(length, dx, "road length")
+    x = x0 + np.arange(nx) * dx
+    y = _lateral_axis(width, dy)
+    ny = y.size
+
+    shares = np.array([s.share for s in segments])
+    bounds = np.concatenate([[0.0], np.cumsum(shares) / shares.sum()]) * (x[-1] - x0)
+    # junction j between samples i_j and i_j + 1 (half-way); segment s owns samples [first_s, last_s]
+    cut = [int(round(b / dx - 0.5)) for b in bounds[1:-1]]
+    first = [0] + [c + 1 for c in cut]
+    last = [c for c in cut] + [nx - 1]
+    for s, (a, b) in enumerate(zip(first, last)):
+        if b - a + 1 < 2:
+            raise EroadInputError(
+                f"segment {s} ({segments[s].label or 'unnamed'}) gets fewer than 2 samples of dx = {dx} m; "
+                "lengthen the road or its share")
+
+    z = np.empty((nx, ny))
+    fields = []
+    for s, (a, b) in enumerate(zip(first, last)):
+        ss = np.random.SeedSequence(int(seed), spawn_key=(s,))
+        seg_len = (b - a) * dx
+        f = harmonic_field(params[s], seg_len, width, ss, lateral=ny > 1)
+        z[a:b + 1] = f.grid(x[a], b - a + 1, y)
+        fields.append(f)
+
+    steps = np.abs(np.diff(z, axis=0))
+    mask = np.ones(nx - 1, bool)
+    mask[cut] = False
+    med_step = float(np.median(steps[mask])) if mask.any() else float(np.median(steps))
+
+    sy = PATCH_SY_OVER_DY * dy
+    junctions = []
+    for j, c in enumerate(cut):
+        xj = x[c] + 0.5 * dx
+        d = fields[j + 1].evaluate(np.full(ny, xj), y) - fields[j].evaluate(np.full(ny, xj), y)
+        a_lat = _solve_lateral(y, 0.5 * d, sy)
+        half = 0.5 * float(np.max(np.abs(d)))
+        sx_need = WINDOW_SLOPE * half * dx / (PATCH_STEP_FRACTION * med_step) if med_step > 0 else 0.0
+        len_left = (last[j] - first[j] + 0.5) * dx
+        len_right = (last[j + 1] - first[j + 1] + 0.5) * dx
+        sx_cap = min(len_left, len_right) / PATCH_SUPPORT
+        sx = min(max(sx_need, 10.0 * dx), sx_cap)
+        reach = int(math.ceil(PATCH_SUPPORT * sx / dx)) + 1
+        lo, hi = max(0, c + 1 - reach), min(nx, c + 1 + reach)
+        u = x[lo:hi] - xj
+        sign = np.where(u < 0, 1.0, -1.0)
+        lat = 0.5 * d if ny == 1 else np.exp(
+            -0.5 * ((y[:, None] - y[None, :]) / sy) ** 2) @ a_lat
+        z[lo:hi] += (sign * _window(u, sx))[:, None] * lat[None, :]
+        junctions.append({"x": float(xj), "sx": float(sx), "n_j": float(1.0 / (4 * PATCH_SUPPORT * sx)),
+                          "sy": float(sy), "sx_capped": bool(sx_need > sx_cap),
+                          "max_offset_removed": float(np.max(np.abs(d)))})
+    for j, c in enumerate(cut):
+        junctions[j]["max_step"] = float(np.max(np.abs(z[c + 1] - z[c])))
+
+    edges = [float(x[0])] + [jc["x"] for jc in junctions] + [float(x[-1])]
+    meta = {
+        "generator": "roadlib.segments.segmented_surface",
+        "seed": int(seed),
+        "segments": [dict(s.to_dict(), start=float(edges[i]), end=float(edges[i + 1]))
+                     for i, s in enumerate(segments)],
+        "junctions": junctions,
+        "median_step": med_step,
+        "dx": float(dx), "dy": float(dy),
+    }
+    return RoadSurface(x, y, z, meta)

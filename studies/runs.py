@@ -1,0 +1,642 @@
+"""Archived runs: one folder per study run that can be trusted later.
+
+Every study writes ``<root>/<study>/<run-id>/`` (``root`` is ``results`` by
+default)::
+
+    config.toml     resolved configuration of the run (TOML, written at start)
+    run.json        command line, overrides, git commit and dirty flag, host,
+                    package versions, seed, start/end time, wall time, status
+    data/           numerical results (CSV, NPZ, ...)
+    figures/        plots (PNG for looking, PDF for papers)
+    summary.json    machine-readable key results (written by the study)
+    error.txt       traceback, only when the run failed
+
+The folder is built as a hidden temporary folder ``.tmp-<run-id>`` next to the
+final one and renamed into place when the ``with`` block ends: with status
+``"complete"`` on success, with status ``"failed"`` (and ``error.txt``) when the
+block raised, so nothing is lost.  A run never overwrites another run: the
+final name is reserved with an atomic ``mkdir`` and a fresh run-id is drawn if
+it is taken.
+
+This module is for writing and reading archives; it does not know what a study
+computes.  Use it as::
+
+    with RunArchive("chassis", config, seed=7) as run:
+        np.savez(run.data_dir / "spectra.npz", ...)
+        fig.savefig(run.figures_dir / "band_energy.png")
+        run.write_summary({"n_cases": 12, ...})
+    print(run.path)          # the final folder
+
+Inside the block, :attr:`RunArchive.path` is the temporary folder; write files
+relative to it (do not store its absolute path in results), it becomes the
+final folder on exit.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import errno
+import hashlib
+import json
+import math
+import os
+import platform
+import shlex
+import socket
+import subprocess
+import sys
+import time
+import traceback
+from dataclasses import dataclass, field, fields, is_dataclass
+from importlib import metadata
+from pathlib import Path
+from typing import Any, Iterator
+
+import numpy as np
+import tomli_w
+
+from eroad.errors import EroadInputError
+
+__all__ = [
+    "RunArchive",
+    "RunRecord",
+    "list_runs",
+    "load_run",
+    "find_run",
+    "write_json_atomic",
+    "git_state",
+    "package_versions",
+    "new_run_id",
+]
+
+#: distributions whose versions are recorded in run.json (absent ones -> null)
+VERSIONED_PACKAGES = ("eroad", "exudyn", "casadi", "numpy", "scipy", "pandas",
+                      "dask", "distributed")
+
+#: file names inside a run folder
+RUN_FILE = "run.json"
+SUMMARY_FILE = "summary.json"
+CONFIG_FILE = "config.toml"
+ERROR_FILE = "error.txt"
+TMP_PREFIX = ".tmp-"
+
+_REPO_DIR = Path(__file__).resolve().parents[1]
+
+
+# ---------------------------------------------------------------------------
+# small helpers: JSON / TOML conversion and atomic writes
+# ---------------------------------------------------------------------------
+def _jsonable(obj: Any) -> Any:
+    """Convert ``obj`` to plain JSON types (numpy -> Python, Path -> str,
+    dataclass -> dict, tuple/set -> list, non-finite float -> None)."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple, set, frozenset)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, np.generic):
+        return _jsonable(obj.item())
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, (str, int, bool)) or obj is None:
+        return obj
+    if isinstance(obj, Path):
+        return str(obj)
+    if isinstance(obj, (_dt.datetime, _dt.date)):
+        return obj.isoformat()
+    if is_dataclass(obj) and not isinstance(obj, type):
+        return _jsonable({f.name: getattr(obj, f.name) for f in fields(obj)})
+    raise TypeError(f"cannot write {type(obj).__name__} to JSON: {obj!r:.80}")
+
+
+def write_json_atomic(path: str | os.PathLike, obj: Any, *, indent: int = 2) -> Path:
+    """Write ``obj`` as JSON to ``path`` atomically.
+
+    The text goes to a temporary file in the same directory, is flushed and
+    fsync'ed, and is renamed over ``path`` with :func:`os.replace`, so a reader
+    sees either the old or the new file, never a partial one.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Destination file; its directory must exist.
+    obj : Any
+        JSON-able data.  NumPy scalars and arrays, ``Path``, tuples, dataclasses
+        and datetimes are converted; non-finite floats (NaN, inf) are written as
+        ``null`` so the file is standard JSON.
+    indent : int, optional
+        Indentation of the JSON text (default 2).
+
+    Returns
+    -------
+    pathlib.Path
+        The written path.
+    """
+    path = Path(path)
+    text = json.dumps(_jsonable(obj), indent=indent, allow_nan=False) + "\n"
+    # not tempfile.mkstemp: its 0600 mode would make shared results unreadable
+    tmp = path.parent / f".{path.name}.{os.getpid()}.{os.urandom(4).hex()}.tmp"
+    try:
+        with open(tmp, "x", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _tomlable(obj: Any) -> Any:
+    """Convert a config to types tomli_w accepts; ``None`` entries are dropped
+    (TOML has no null: an absent key means "default")."""
+    if is_dataclass(obj) and not isinstance(obj, type):
+        obj = {f.name: getattr(obj, f.name) for f in fields(obj)}
+    if isinstance(obj, dict):
+        return {str(k): _tomlable(v) for k, v in obj.items() if v is not None}
+    if isinstance(obj, (list, tuple, set, frozenset)):
+        return [_tomlable(v) for v in obj if v is not None]
+    if isinstance(obj, np.ndarray):
+        return _tomlable(obj.tolist())
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def _utc_now() -> _dt.datetime:
+    return _dt.datetime.now(_dt.timezone.utc)
+
+
+def _iso(t: _dt.datetime) -> str:
+    return t.isoformat(timespec="milliseconds").replace("+00:00", "Z")
+
+
+# ---------------------------------------------------------------------------
+# provenance: run-id, git, versions
+# ---------------------------------------------------------------------------
+def new_run_id(when: _dt.datetime | None = None) -> str:
+    """Return a new run-id ``YYYYmmddTHHMMSSZ-xxxxxxxx``.
+
+    The first part is the UTC time (sortable), the second 8 hex digits of a
+    SHA-256 hash of the time in ns, the process id and 8 random bytes, so two
+    runs started in the same second get different ids.
+
+    Parameters
+    ----------
+    when : datetime.datetime, optional
+        UTC time to stamp (default: now).
+
+    Returns
+    -------
+    str
+        The run-id.
+    """
+    when = when or _utc_now()
+    salt = f"{time.time_ns()}-{os.getpid()}-".encode() + os.urandom(8)
+    return f"{when.strftime('%Y%m%dT%H%M%SZ')}-{hashlib.sha256(salt).hexdigest()[:8]}"
+
+
+def git_state(repo: str | os.PathLike | None = None) -> dict[str, Any]:
+    """Git commit and dirty flag of the repository holding this package.
+
+    Parameters
+    ----------
+    repo : str or os.PathLike, optional
+        Folder to inspect (default: the folder containing the ``studies``
+        package, i.e. the eroad source tree of an editable install).
+
+    Returns
+    -------
+    dict
+        ``{"commit": str | None, "dirty": bool | None}``.  ``dirty`` is true when
+        tracked files differ from the commit (untracked files such as new
+        results are not counted).  Both are ``None`` when git is not installed,
+        the folder is not the top of a git work tree (e.g. an installed wheel),
+        or git fails.
+    """
+    repo = Path(repo) if repo is not None else _REPO_DIR
+    out: dict[str, Any] = {"commit": None, "dirty": None}
+
+    def git(*args: str) -> str:
+        return subprocess.run(["git", "-C", str(repo), *args], capture_output=True,
+                              text=True, timeout=10, check=True).stdout.strip()
+    try:
+        top = Path(git("rev-parse", "--show-toplevel")).resolve()
+        if top != repo.resolve():
+            return out
+        out["commit"] = git("rev-parse", "HEAD")
+        out["dirty"] = bool(git("status", "--porcelain", "--untracked-files=no"))
+    except (OSError, subprocess.SubprocessError):
+        pass
+    return out
+
+
+def package_versions(names: tuple[str, ...] = VERSIONED_PACKAGES) -> dict[str, str | None]:
+    """Installed versions of ``names`` plus Python, read from package metadata
+    (nothing is imported, so this is fast).
+
+    Parameters
+    ----------
+    names : tuple of str
+        Distribution names.
+
+    Returns
+    -------
+    dict
+        ``{"python": "3.11.7", "exudyn": "1.13.6", ...}``; ``None`` for a
+        distribution that is not installed.
+    """
+    versions: dict[str, str | None] = {"python": platform.python_version()}
+    for name in names:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = None
+    return versions
+
+
+# ---------------------------------------------------------------------------
+# the archive
+# ---------------------------------------------------------------------------
+class RunArchive:
+    """Context manager writing one archived run ``<root>/<study>/<run-id>/``.
+
+    Parameters
+    ----------
+    study : str
+        Study name, used as folder name (letters, digits, ``-``, ``_``, ``.``).
+    config : dict
+        Resolved configuration of the run (all parameters after defaults and
+        overrides are applied); written to ``config.toml``.  NumPy values,
+        tuples, ``Path`` and dataclasses are converted; ``None`` values are
+        omitted because TOML has no null.
+    root : str or os.PathLike, optional
+        Results root (default ``"results"``, relative to the working folder).
+    seed : int, optional
+        Root seed of the run, recorded in ``run.json``.
+    command : list of str or str, optional
+        Command line to record (default ``sys.argv``).
+    overrides : list of str or dict, optional
+        Configuration overrides given by the user (e.g. ``["frame.k=2.0"]``),
+        recorded in ``run.json``.
+
+    Attributes
+    ----------
+    run_id : str
+        The run-id (final once the block has ended).
+    path : pathlib.Path
+        The run folder: the temporary folder inside the block, the final
+        folder afterwards.
+    status : str
+        ``"running"``, ``"complete"`` or ``"failed"``.
+    info : dict
+        The content of ``run.json``.
+
+    Notes
+    -----
+    The archive never suppresses an exception: the block's exception
+    propagates after the folder has been renamed with status ``"failed"`` and
+    the traceback written to ``error.txt``.  If the process is killed hard
+    (SIGKILL, power loss), the hidden ``.tmp-<run-id>`` folder stays behind with
+    status ``"running"``; :func:`list_runs` ignores it.
+    """
+
+    def __init__(self, study: str, config: dict, root: str | os.PathLike = "results",
+                 seed: int | None = None, command: list[str] | str | None = None,
+                 overrides: list[str] | dict | None = None) -> None:
+        if not study or not all(c.isalnum() or c in "-_." for c in study) or study[0] == ".":
+            raise EroadInputError(f"study name {study!r} must be letters, digits, '-', '_' "
+                                  "or '.', not starting with '.'")
+        self.study = study
+        self.config = dict(config)
+        self.root = Path(root)
+        self.seed = seed
+        if command is None:
+            command = list(sys.argv)
+        self.command = command
+        self.overrides = overrides
+        self.run_id = ""
+        self.path = Path()
+        self.status = "new"
+        self.info: dict[str, Any] = {}
+        self._t0 = 0.0
+
+    # -- folders ------------------------------------------------------------
+    @property
+    def study_dir(self) -> Path:
+        """Folder holding all runs of this study, ``<root>/<study>``."""
+        return self.root / self.study
+
+    @property
+    def data_dir(self) -> Path:
+        """``<run>/data``: numerical results."""
+        return self.path / "data"
+
+    @property
+    def figures_dir(self) -> Path:
+        """``<run>/figures``: plots."""
+        return self.path / "figures"
+
+    # -- writing --------------------------------------------------------------
+    def write_summary(self, summary: dict) -> Path:
+        """Write ``summary.json`` (atomically; may be called repeatedly).
+
+        Parameters
+        ----------
+        summary : dict
+            Machine-readable key results with units in the key names or values.
+
+        Returns
+        -------
+        pathlib.Path
+            Path of ``summary.json`` (inside the temporary folder while the
+            block runs).
+        """
+        self._require_open()
+        return write_json_atomic(self.path / SUMMARY_FILE, summary)
+
+    def write_json(self, name: str, obj: Any) -> Path:
+        """Write ``obj`` atomically to ``data/<name>`` as JSON.
+
+        Parameters
+        ----------
+        name : str
+            File name inside ``data/`` (e.g. ``"bands.json"``).
+        obj : Any
+            JSON-able data (see :func:`write_json_atomic`).
+
+        Returns
+        -------
+        pathlib.Path
+            Path of the written file.
+        """
+        self._require_open()
+        return write_json_atomic(self.data_dir / name, obj)
+
+    def _require_open(self) -> None:
+        if self.status != "running":
+            raise RuntimeError(f"run archive is {self.status}; write inside the with block")
+
+    # -- context manager --------------------------------------------------------
+    def __enter__(self) -> "RunArchive":
+        if self.status != "new":
+            raise RuntimeError("a RunArchive can be entered only once")
+        self.study_dir.mkdir(parents=True, exist_ok=True)
+        start = _utc_now()
+        self._t0 = time.perf_counter()
+        for _ in range(100):
+            self.run_id = new_run_id(start)
+            tmp = self.study_dir / f"{TMP_PREFIX}{self.run_id}"
+            try:
+                tmp.mkdir()
+                break
+            except FileExistsError:
+                continue
+        else:  # pragma: no cover - 100 hash collisions
+            raise RuntimeError(f"cannot create a temporary run folder in {self.study_dir}")
+        self.path = tmp
+        self.data_dir.mkdir()
+        self.figures_dir.mkdir()
+        self.status = "running"
+        command = self.command
+        self.info = {
+            "study": self.study,
+            "run_id": self.run_id,
+            "status": self.status,
+            "command": command if isinstance(command, str) else shlex.join(map(str, command)),
+            "argv": None if isinstance(command, str) else [str(c) for c in command],
+            "overrides": self.overrides,
+            "cwd": os.getcwd(),
+            "git": git_state(),
+            "host": {
+                "hostname": socket.gethostname(),
+                "platform": platform.platform(),
+                "machine": platform.machine(),
+                "cpu_count": os.cpu_count(),
+            },
+            "versions": package_versions(),
+            "seed": self.seed,
+            "start_utc": _iso(start),
+            "end_utc": None,
+            "wall_s": None,
+            "error": None,
+        }
+        try:
+            (self.path / CONFIG_FILE).write_bytes(tomli_w.dumps(_tomlable(self.config)).encode())
+        except TypeError as exc:
+            raise TypeError(f"config of study {self.study!r} cannot be written as TOML: {exc}") \
+                from exc
+        write_json_atomic(self.path / RUN_FILE, self.info)
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        if self.status != "running":
+            return False
+        end = _utc_now()
+        self.status = "complete" if exc_type is None else "failed"
+        self.info.update(status=self.status, end_utc=_iso(end),
+                         wall_s=round(time.perf_counter() - self._t0, 3))
+        if exc_type is not None:
+            self.info["error"] = {"type": exc_type.__name__, "message": str(exc)}
+            (self.path / ERROR_FILE).write_text(
+                "".join(traceback.format_exception(exc_type, exc, tb)), encoding="utf-8")
+        self._move_into_place()
+        return False  # never swallow the exception
+
+    def _move_into_place(self) -> None:
+        """Rename the temporary folder to ``<study>/<run-id>``, never over
+        another run: the final name is reserved with an atomic ``mkdir`` (which
+        fails if the name exists) and the temporary folder is renamed over that
+        empty reserved folder (allowed by POSIX ``rename``)."""
+        tmp = self.path
+        for attempt in range(100):
+            if attempt:
+                self.run_id = new_run_id()
+            final = self.study_dir / self.run_id
+            try:
+                final.mkdir()
+            except FileExistsError:
+                continue
+            self.info["run_id"] = self.run_id
+            write_json_atomic(tmp / RUN_FILE, self.info)
+            try:
+                os.rename(tmp, final)
+            except OSError as exc:  # pragma: no cover - platforms without rename-over-dir
+                final.rmdir()
+                if exc.errno in (errno.EEXIST, errno.ENOTEMPTY):
+                    continue
+                raise
+            self.path = final
+            return
+        raise RuntimeError(f"no free run-id in {self.study_dir}")  # pragma: no cover
+
+
+# ---------------------------------------------------------------------------
+# reading archives
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class RunRecord:
+    """One archived run as read from disk.
+
+    Attributes
+    ----------
+    path : pathlib.Path
+        The run folder.
+    info : dict
+        Content of ``run.json``.
+    summary : dict or None
+        Content of ``summary.json`` (``None`` if absent).
+    """
+
+    path: Path
+    info: dict = field(repr=False)
+    summary: dict | None = field(default=None, repr=False)
+
+    @property
+    def study(self) -> str:
+        """Study name."""
+        return str(self.info.get("study", self.path.parent.name))
+
+    @property
+    def run_id(self) -> str:
+        """Run-id (the folder name)."""
+        return self.path.name
+
+    @property
+    def status(self) -> str:
+        """``"complete"``, ``"failed"`` or ``"running"``."""
+        return str(self.info.get("status", "unknown"))
+
+    @property
+    def start(self) -> str:
+        """Start time, ISO 8601 UTC."""
+        return str(self.info.get("start_utc") or "")
+
+    @property
+    def wall_s(self) -> float | None:
+        """Wall-clock duration [s] (``None`` if the run did not finish)."""
+        w = self.info.get("wall_s")
+        return None if w is None else float(w)
+
+
+def load_run(path: str | os.PathLike) -> RunRecord:
+    """Read an archived run folder.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A run folder (containing ``run.json``).
+
+    Returns
+    -------
+    RunRecord
+        The run.
+
+    Raises
+    ------
+    eroad.errors.EroadInputError
+        If the folder does not exist, has no ``run.json``, or a JSON file is
+        not valid JSON.
+    """
+    path = Path(path)
+    if not path.is_dir():
+        raise EroadInputError(f"{path}: no such run folder")
+    run_file = path / RUN_FILE
+    if not run_file.is_file():
+        raise EroadInputError(f"{path}: not a run folder (no {RUN_FILE})")
+
+    def read(p: Path) -> dict:
+        try:
+            data = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError) as exc:
+            raise EroadInputError(f"{p}: cannot read JSON: {exc}") from None
+        if not isinstance(data, dict):
+            raise EroadInputError(f"{p}: expected a JSON object")
+        return data
+
+    info = read(run_file)
+    summary_file = path / SUMMARY_FILE
+    summary = read(summary_file) if summary_file.is_file() else None
+    return RunRecord(path=path, info=info, summary=summary)
+
+
+def _iter_run_dirs(root: Path) -> Iterator[Path]:
+    if not root.is_dir():
+        return
+    for study in sorted(root.iterdir()):
+        if not study.is_dir() or study.name.startswith("."):
+            continue
+        for run in sorted(study.iterdir()):
+            if run.is_dir() and not run.name.startswith(".") and (run / RUN_FILE).is_file():
+                yield run
+
+
+def list_runs(root: str | os.PathLike = "results", study: str | None = None) -> list[RunRecord]:
+    """All archived runs under ``root``, oldest first.
+
+    Parameters
+    ----------
+    root : str or os.PathLike, optional
+        Results root (default ``"results"``).  A missing root gives ``[]``.
+    study : str, optional
+        Only runs of this study.
+
+    Returns
+    -------
+    list of RunRecord
+        Sorted by start time, then study and run-id.  Hidden folders
+        (temporary ``.tmp-*`` runs still in progress or abandoned) and folders
+        without ``run.json`` are skipped; a run whose JSON is unreadable is
+        listed with status ``"unreadable"``.
+    """
+    records = []
+    for run_dir in _iter_run_dirs(Path(root)):
+        if study is not None and run_dir.parent.name != study:
+            continue
+        try:
+            records.append(load_run(run_dir))
+        except EroadInputError as exc:
+            records.append(RunRecord(path=run_dir, info={"status": "unreadable",
+                                                         "error": {"message": str(exc)}}))
+    return sorted(records, key=lambda r: (r.start, r.study, r.run_id))
+
+
+def find_run(run: str | os.PathLike, root: str | os.PathLike = "results") -> RunRecord:
+    """Find a run by folder path, run-id or unique run-id prefix.
+
+    Parameters
+    ----------
+    run : str or os.PathLike
+        A run folder, ``<study>/<run-id>`` relative to ``root``, a run-id, or
+        a prefix of a run-id that matches exactly one run.
+    root : str or os.PathLike, optional
+        Results root searched for run-ids (default ``"results"``).
+
+    Returns
+    -------
+    RunRecord
+        The run.
+
+    Raises
+    ------
+    eroad.errors.EroadInputError
+        If nothing or more than one run matches.
+    """
+    p = Path(run)
+    for candidate in (p, Path(root) / p):
+        if (candidate / RUN_FILE).is_file():
+            return load_run(candidate)
+    name = str(run)
+    matches = [d for d in _iter_run_dirs(Path(root)) if d.name == name]
+    if not matches:
+        matches = [d for d in _iter_run_dirs(Path(root)) if d.name.startswith(name)]
+    if not matches:
+        raise EroadInputError(f"run {name!r}: no run folder or run-id under {root}")
+    if len(matches) > 1:
+        shown = ", ".join(f"{d.parent.name}/{d.name}" for d in matches[:3])
+        raise EroadInputError(f"run {name!r} is ambiguous under {root}: {len(matches)} runs "
+                              f"match ({shown}{', ...' if len(matches) > 3 else ''})")
+    return load_run(matches[0])
