@@ -396,6 +396,7 @@ class Entry:
         return {
             "effect": self.effect, "parameters": self.effects, "k": self.k,
             "heldout_gap_before": self.heldout_gap_before, "heldout_gap_after": self.heldout_gap_after,
+            "heldout_gap_after_per_seed": [float(v) for v in self.after],
             "shrink_fraction": self.shrink_fraction, "shrink_spread": self.shrink_spread,
             "shrink_min": float(s.min()), "shrink_max": float(s.max()),
             "shrink_excess": self.shrink_excess, "noise_floor": self.floor,

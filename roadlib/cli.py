@@ -7,7 +7,7 @@ modules; nothing here is needed to use roadlib from Python.
 Subcommands
 -----------
 ``generate``  ISO 8608 road (one class or explicit parameters, or segments) to
-              ``.npz`` / ``.crg``, plus ``<stem>.summary.json`` beside it.
+              ``FILE.npz`` / ``FILE.crg``, plus ``FILE.npz.summary.json`` beside it.
 ``psd``       Welch PSD + ISO fit of a road file or a two-column profile.
 ``iri``       IRI per segment of a two-column profile or a track of a road file.
 ``plot``      PNG of profile, surface map and PSD against the ISO classes.
@@ -193,7 +193,7 @@ def _print(args, summary: dict, text: str) -> None:
 
 # ----------------------------------------------------------------------------- commands
 def cmd_generate(args) -> int:
-    from roadlib.metrics import fit_iso_psd, profile_psd
+    from roadlib.metrics import default_band, fit_iso_psd, profile_psd
     from roadlib.psd import class_gd0
     from roadlib.segments import RoadSegment, segmented_surface
     from roadlib.synthesis import SpectralParams, synth_surface
@@ -203,7 +203,7 @@ def cmd_generate(args) -> int:
         raise EroadInputError(f"--out {out}: use a .npz or .crg file name")
     if not out.parent.exists():
         raise EroadInputError(f"--out {out}: folder {out.parent} does not exist")
-    summary_path = out.with_name(out.stem + ".summary.json")
+    summary_path = out.with_name(out.name + ".summary.json")
     _refuse_existing(out, args.force)
     _refuse_existing(summary_path, args.force)
     if args.seed < 0:
@@ -241,22 +241,26 @@ def cmd_generate(args) -> int:
     surf.meta["command"] = "eroad road generate"
 
     centre = float(surf.y[np.argmin(np.abs(surf.y))])
-    est = profile_psd(surf.track(centre), surf.dx)
-    from roadlib.metrics import default_band
-    lo, hi = default_band(est)
-    fit = fit_iso_psd(est, band=(max(lo, args.nmin), min(hi, 0.97 * args.nmax)))
+    try:
+        est = profile_psd(surf.track(centre), surf.dx)
+        lo, hi = default_band(est)
+        fit = fit_iso_psd(est, band=(max(lo, args.nmin), min(hi, 0.97 * args.nmax))).to_dict()
+        fit_text = (f"centre track Gd(n0) = {fit['Gd_n0']:.3e} m^3, w = {fit['w']:.2f}, "
+                    f"class {fit['class']}")
+    except EroadInputError as exc:  # road too short for a PSD estimate
+        fit = {"error": str(exc)}
+        fit_text = f"no PSD check ({exc})"
     surf.save(out, overwrite=True)
     summary = {
         "command": "road generate", "out": str(out), "seed": args.seed,
         "params": params.to_dict() if params else None,
         "segments": surf.meta.get("segments"), "junctions": surf.meta.get("junctions"),
         "surface": surf.summary(),
-        "centre_track_psd": {"y": centre, **fit.to_dict()},
+        "centre_track_psd": {"y": centre, **fit},
     }
     _write_text_atomic(summary_path, json.dumps(summary, indent=2) + "\n")
     _print(args, summary, f"wrote {out} ({surf.x.size} x {surf.y.size} grid, {surf.length:g} m x "
-           f"{surf.width:g} m, z rms {1000 * np.std(surf.z):.2f} mm); centre track Gd(n0) = "
-           f"{fit.Gd_n0:.3e} m^3, w = {fit.w:.2f}, class {fit.iso_class}; summary {summary_path}")
+           f"{surf.width:g} m, z rms {1000 * np.std(surf.z):.2f} mm); {fit_text}; summary {summary_path}")
     return 0
 
 
@@ -358,7 +362,7 @@ def register(subparsers) -> None:
 
     g = sub.add_parser("generate", help="generate a road to .npz or .crg",
                        description="Generate an ISO 8608 road by harmonic superposition. Give one class, an "
-                       "explicit level, or segments. Writes FILE and <stem>.summary.json beside it.")
+                       "explicit level, or segments. Writes FILE and FILE.summary.json beside it.")
     src = g.add_argument_group("road spectrum (one of)")
     src.add_argument("--class", dest="iso_class", metavar="CLASS", help="ISO 8608 class A-H (geometric mean level)")
     src.add_argument("--gd0", type=_positive, metavar="GQ_N0", help="Gd(n0) at n0 = 0.1 cycles/m [m^3], e.g. 256e-6")

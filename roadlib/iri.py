@@ -109,12 +109,14 @@ def rectified_slope(x, z, speed: float = SPEED):
     Returns
     -------
     xs : ndarray
-        Start of each step [m].
+        Start of each step [m]: slope i of the k-sample moving average joins the
+        averages centred at x_i + (k-1) dx/2 and one dx further.
     rs : ndarray
         |zs' - zu'| after each step [m/m].
     """
     x, z, dx = _check_profile(x, z)
-    k = max(1, int(round(BASE_LENGTH / dx))) if dx < BASE_LENGTH else 1
+    # base length in samples, rounded half away from zero like the ASTM code (nint)
+    k = max(1, int(math.floor(BASE_LENGTH / dx + 0.5))) if dx < BASE_LENGTH else 1
     slope = (z[k:] - z[:-k]) / (k * dx)             # slope of the k-sample moving average
     i11 = int(round(INIT_LENGTH / dx))
     if i11 >= x.size:
@@ -132,7 +134,7 @@ def rectified_slope(x, z, speed: float = SPEED):
                           a20 * z0 + a21 * z1 + a22 * z2 + a23 * z3 + p2 * s,
                           a30 * z0 + a31 * z1 + a32 * z2 + a33 * z3 + p3 * s)
         rs[i] = abs(z0 - z2)
-    return x[:slope.size], rs
+    return x[:slope.size] + 0.5 * (k - 1) * dx, rs
 
 
 def iri_segments(x, z, segment_length: float, start: float | None = None,
@@ -166,7 +168,7 @@ def iri_segments(x, z, segment_length: float, start: float | None = None,
     x_start = float(x[0]) if start is None else float(start)
     if not (x[0] <= x_start < x[-1]):
         raise EroadInputError(f"IRI: segment start {x_start:g} m is outside the profile {x[0]:g}..{x[-1]:g} m")
-    x_end = float(xs[-1] + dx)                     # end of the last simulated step
+    x_end = float(x[-1])                           # a segment is complete if the data cover it
     mid = xs + 0.5 * dx
     out = []
     a = x_start

@@ -160,11 +160,16 @@ def default_band(est: PsdEstimate) -> tuple[float, float]:
     """Fit band [cycles/m]: the ISO band 0.011-2.83 clipped to >= 10 Welch bins and <= 0.8 Nyquist.
 
     The lower limit keeps the Hann window's smoothing bias of a n^-2 spectrum
-    below ~1.5 % (relative bias ~ w (w+1)/2 * 0.5 (bin/n)^2).
+    below ~1.5 % (relative bias ~ w (w+1)/2 * 0.5 (bin/n)^2).  For records too
+    short for that (the band would shrink below an octave) it drops to 2 bins.
     """
     dn = 1.0 / (est.nperseg * est.dx)
     nyq = 0.5 / est.dx
-    return max(ISO_BAND[0], 10.0 * dn), min(ISO_BAND[1], 0.8 * nyq)
+    hi = min(ISO_BAND[1], 0.8 * nyq)
+    lo = max(ISO_BAND[0], 10.0 * dn)
+    if lo > 0.5 * hi:  # short record: accept more smoothing bias rather than no fit
+        lo = max(ISO_BAND[0], 2.0 * dn)
+    return lo, hi
 
 
 def fit_iso_psd(psd, band: tuple[float, float] | None = None, w: float | None = None,

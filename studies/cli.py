@@ -60,6 +60,8 @@ def _usage(parser: argparse.ArgumentParser) -> int:
 def _fmt_wall(wall: float | None) -> str:
     if wall is None:
         return "-"
+    if wall < 10:
+        return f"{wall:.2f} s"
     if wall < 600:
         return f"{wall:.1f} s"
     return f"{wall / 60:.1f} min"

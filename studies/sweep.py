@@ -319,7 +319,8 @@ def dask_client(scheduler: str | None = None, n_workers: int = 2,
     scheduler : str, optional
         Address of an existing scheduler (``"tcp://host:8786"``).  Default: a
         new ``LocalCluster`` with ``n_workers`` worker processes, one thread
-        each, no dashboard, worker logs at ERROR level.
+        each, no dashboard, scheduler and HTTP server on free ports, worker
+        logs at ERROR level.
     n_workers : int, optional
         Number of local worker processes (default 2; ignored with
         ``scheduler``).
@@ -359,7 +360,10 @@ def dask_client(scheduler: str | None = None, n_workers: int = 2,
                     raise ValueError(f"n_workers must be >= 1, got {n_workers}")
                 cluster = stack.enter_context(LocalCluster(
                     n_workers=n_workers, threads_per_worker=1, processes=True,
-                    dashboard_address=None, silence_logs=logging.ERROR))
+                    # HTTP server on a free port, no dashboard: a fixed :8787 would
+                    # warn when another cluster on the host already holds it
+                    dashboard_address=":0", scheduler_kwargs={"dashboard": False},
+                    silence_logs=logging.ERROR))
                 client = stack.enter_context(Client(cluster, set_as_default=False))
                 # a failing case is re-raised by run_cases; the worker need not log it too
                 client.register_plugin(_QuietWorkerLogs(), name="eroad-quiet-logs")
@@ -400,7 +404,8 @@ class SweepResult:
     cached : list of int
         Indices of the cases loaded from the cache.
     case_wall_s : list of float or None
-        Compute time of each case [s] (as recorded when it was computed).
+        Compute time of each case in the worker [s]; None for cases loaded
+        from the cache.
     wall_s : float
         Wall time of the call [s].
     func : str
@@ -476,7 +481,7 @@ def run_cases(func: str | CaseFunction, cases: list[dict], cache_dir: str | os.P
         systems do not pickle) and be importable in the workers.
     cases : list of dict
         Parameter cases; str keys, JSON-able values.  Identical cases (same
-        key) are computed once.
+        key) are computed once and share one result dict.
     cache_dir : str or os.PathLike
         Cache folder, created if missing.  Shared between sweeps is fine: keys
         include the function name and code version.
@@ -583,8 +588,6 @@ def run_cases(func: str | CaseFunction, cases: list[dict], cache_dir: str | os.P
     finally:
         bar.close()
 
-    for i in cached:
-        walls[i] = None
     return SweepResult(cases=cases, results=results, keys=keys,  # type: ignore[arg-type]
                        computed=sorted(computed), cached=cached, case_wall_s=walls,
                        wall_s=time.perf_counter() - t_start, func=name, code_version=version)

@@ -29,7 +29,7 @@ def test_generate_psd_plot_crg(tmp_path, capsys):
     assert code == 0
     summary = json.loads(so)
     assert summary["centre_track_psd"]["class"] == "C"
-    assert json.loads((tmp_path / "c.summary.json").read_text()) == summary
+    assert json.loads((tmp_path / "c.npz.summary.json").read_text()) == summary
     s = RoadSurface.load(out)
     assert s.z.shape == (5001, 21) and s.meta["seed"] == 3
 

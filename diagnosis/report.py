@@ -1,0 +1,477 @@
+"""The diagnosis report: ``summary.json``, figures and ``report.md`` in one run folder.
+
+What it is for: turning the results of ``diagnosis.where``, ``diagnosis.compare``
+and ``diagnosis.which`` into what a user reads.  :func:`build_summary` makes the
+machine-readable summary; every figure is drawn from that summary alone (the
+``plot_*`` functions take the summary dict, so a saved ``summary.json`` can be
+re-plotted without recomputing); :func:`write_report` writes everything into a
+temporary folder beside ``out`` and renames it into place.
+
+``summary.json`` keys (always present): ``verdict`` (an effect name, ``"a+b"`` for
+a pair, or ``"none"``), ``verdict_confidence``, ``verdict_reason``,
+``localization`` (list of {channel, band_hz [lo, hi], segment, log_psd_ratio,
+significant, ci_lo, ci_hi, ...}), ``localization_settings``, ``ranking`` (best
+first, list of {effect, parameters, heldout_gap_before, heldout_gap_after,
+shrink_fraction, shrink_spread, ...}), ``nominal``, ``how_far``,
+``transmissibility``, ``front_rear``, ``distribution``, ``meta``.
+
+What it is not: the command line (``diagnosis.cli``) or any computation.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+from matplotlib import colormaps
+from matplotlib.figure import Figure
+
+from eroad.errors import EroadInputError
+
+__all__ = ["build_summary", "write_report", "plot_heatmap", "plot_segments",
+           "plot_transmissibility", "plot_ranking", "plot_shrink_bands", "render_markdown",
+           "jsonable"]
+
+
+def jsonable(obj: Any) -> Any:
+    """Convert numpy types to Python, non-finite floats to None (valid JSON)."""
+    if isinstance(obj, Mapping):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, (np.bool_, bool)):
+        return bool(obj)
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if math.isfinite(obj) else None
+    return obj
+
+
+def build_summary(localization=None, *, transmissibility=None, front_rear=None, shape=None,
+                  ranking=None, meta: Mapping | None = None) -> dict:
+    """Machine-readable summary of a diagnosis.
+
+    Parameters
+    ----------
+    localization : diagnosis.where.Localization, optional
+    transmissibility : diagnosis.compare.Transmissibility, optional
+    front_rear : diagnosis.compare.FrontRear, optional
+    shape : diagnosis.compare.Shape, optional
+    ranking : diagnosis.which.Ranking, optional
+    meta : mapping, optional
+        Dataset, vehicle, command line, versions... copied under ``meta``.
+
+    Returns
+    -------
+    dict
+        JSON-ready (see module docstring).
+    """
+    s: dict = {"verdict": "none", "verdict_confidence": "none",
+               "verdict_reason": "effect ranking not run", "localization": [],
+               "localization_settings": None, "ranking": [], "nominal": None, "how_far": None,
+               "transmissibility": None, "front_rear": None, "distribution": None,
+               "meta": dict(meta or {})}
+    if localization is not None:
+        L = localization
+        s["localization"] = L.records()
+        s["localization_settings"] = {
+            "q": L.q, "ci_level": L.ci_level, "n_tested": L.n_tested, "n_flagged": L.n_flagged,
+            "channels": list(L.channels), "segments": list(L.segments),
+            "windows_s": [list(w) for w in L.windows],
+            "bands_hz": [[float(b[0]), float(b[2])] for b in L.bands],
+            "band_centres_hz": [float(b[1]) for b in L.bands],
+            "method": "ln(P_sim/P_meas), Welch third-octave band power, F interval, "
+                      "Benjamini-Hochberg FDR with FCR-adjusted intervals"}
+    if transmissibility is not None:
+        s["transmissibility"] = {"q": transmissibility.q, "ci_level": transmissibility.ci_level,
+                                 "pairs": [list(p) for p in transmissibility.pairs],
+                                 "cells": transmissibility.records()}
+    if front_rear is not None:
+        s["front_rear"] = front_rear.records()
+    if shape is not None:
+        s["distribution"] = shape.records()
+    if ranking is not None:
+        R = ranking
+        s["verdict"], s["verdict_confidence"], s["verdict_reason"] = R.verdict, R.confidence, R.reason
+        s["ranking"] = R.records()
+        s["nominal"] = {"heldout_gap": float(np.mean(R.before)), "heldout_gap_per_seed": R.before,
+                        "per_band": R.per_band_before, "noise_floor": R.floor,
+                        "null_gap_mean": R.null.mean, "null_gap_std": R.null.std,
+                        "null_gaps": R.null.gaps, "gap_present": R.gap_present,
+                        "bands_hz": [[float(b[0]), float(b[2])] for b in R.bands],
+                        "band_centres_hz": [float(b[1]) for b in R.bands],
+                        "settings": R.settings}
+        best = R.winner or (R.entries[0] if R.entries else None)
+        if best is not None:
+            pb0, pb1 = np.asarray(best.per_band_before), np.asarray(best.per_band_after)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                sh = 1 - pb1 / pb0
+            s["how_far"] = {
+                "effect": best.effect, "is_verdict": best.effect == R.verdict,
+                "heldout_gap_before": best.heldout_gap_before,
+                "heldout_gap_after": best.heldout_gap_after,
+                "shrink_fraction": best.shrink_fraction, "shrink_spread": best.shrink_spread,
+                "shrink_per_seed": best.shrink_per_seed, "shrink_excess": best.shrink_excess,
+                "per_band": [{"band_hz": [float(b[0]), float(b[2])], "band_centre_hz": float(b[1]),
+                              "gap_before": pb0[i], "gap_after": pb1[i], "shrink": sh[i]}
+                             for i, b in enumerate(R.bands)]}
+    return jsonable(s)
+
+
+# ----------------------------------------------------------------------------- figures
+def _matrix(summary, segment):
+    st = summary["localization_settings"]
+    chans, fc = st["channels"], st["band_centres_hz"]
+    val = np.full((len(chans), len(fc)), np.nan)
+    sig = np.zeros_like(val, dtype=bool)
+    est = np.zeros_like(val, dtype=bool)
+    ci = {c: i for i, c in enumerate(chans)}
+    bi = {round(f, 6): j for j, f in enumerate(fc)}
+    for r in summary["localization"]:
+        if r["segment"] != segment:
+            continue
+        i, j = ci[r["channel"]], bi[round(r["band_centre_hz"], 6)]
+        val[i, j] = np.nan if r["log_psd_ratio"] is None else r["log_psd_ratio"]
+        sig[i, j] = r["significant"]
+        est[i, j] = r["estimable"]
+    return chans, fc, val, sig, est
+
+
+def _vlim(summary):
+    v = [abs(r["log_psd_ratio"]) for r in summary["localization"]
+         if r["log_psd_ratio"] is not None and r["significant"]]
+    return float(np.clip(max(v) if v else 0.5, 0.5, 3.0))
+
+
+def _heat(ax, chans, fc, val, sig, est, vlim):
+    cmap = colormaps["RdBu_r"].copy()
+    cmap.set_bad("0.85")
+    im = ax.imshow(np.ma.masked_invalid(val), cmap=cmap, vmin=-vlim, vmax=vlim, aspect="auto",
+                   origin="upper", interpolation="nearest")
+    ii, jj = np.nonzero(sig)
+    ax.scatter(jj, ii, s=14, marker="o", facecolors="none", edgecolors="k", linewidths=0.9)
+    ax.set_yticks(range(len(chans)))
+    ax.set_yticklabels(chans, fontsize=7)
+    step = max(1, len(fc) // 10)
+    ax.set_xticks(range(0, len(fc), step))
+    ax.set_xticklabels([f"{f:.3g}" for f in fc[::step]], fontsize=7)
+    return im
+
+
+def plot_heatmap(summary: Mapping, path: str | os.PathLike, segment: str = "all") -> Path:
+    """Channel x band heat map of ``ln(P_sim/P_meas)`` for one segment (PNG).
+
+    Circles mark flagged cells; grey cells are not estimable.
+    """
+    chans, fc, val, sig, est = _matrix(summary, segment)
+    fig = Figure(figsize=(8.0, 1.2 + 0.32 * len(chans)), layout="constrained")
+    ax = fig.add_subplot()
+    im = _heat(ax, chans, fc, val, sig, est, _vlim(summary))
+    ax.set_xlabel("third-octave band centre [Hz]")
+    st = summary["localization_settings"]
+    ax.set_title(f"ln(P_sim / P_meas), segment '{segment}': {int(sig.sum())} flagged cells "
+                 f"(o, FDR q = {st['q']:g}); grey: not estimable", fontsize=9)
+    fig.colorbar(im, ax=ax, label="ln(P_sim / P_meas) [-]")
+    fig.savefig(path, dpi=130)
+    return Path(path)
+
+
+def plot_segments(summary: Mapping, path: str | os.PathLike) -> Path:
+    """Per-segment view: one channel x band heat map per road segment (PNG)."""
+    segs = [s for s in summary["localization_settings"]["segments"] if s != "all"] or ["all"]
+    wins = dict(zip(summary["localization_settings"]["segments"],
+                    summary["localization_settings"]["windows_s"]))
+    nch = len(summary["localization_settings"]["channels"])
+    fig = Figure(figsize=(8.0, len(segs) * (0.9 + 0.26 * nch) + 0.6), layout="constrained")
+    axes = fig.subplots(len(segs), 1, squeeze=False)[:, 0]
+    vlim = _vlim(summary)
+    im = None
+    for ax, seg in zip(axes, segs):
+        chans, fc, val, sig, est = _matrix(summary, seg)
+        im = _heat(ax, chans, fc, val, sig, est, vlim)
+        t0, t1 = wins[seg]
+        ax.set_title(f"segment {seg} ({t0:.1f}-{t1:.1f} s): {int(sig.sum())} flagged", fontsize=8)
+    axes[-1].set_xlabel("third-octave band centre [Hz]")
+    fig.colorbar(im, ax=list(axes), label="ln(P_sim / P_meas) [-]", shrink=0.8)
+    fig.savefig(path, dpi=130)
+    return Path(path)
+
+
+def plot_transmissibility(summary: Mapping, path: str | os.PathLike) -> Path:
+    """Axle-to-body transmissibility log ratio per band with its interval, per pair (PNG)."""
+    T = summary["transmissibility"]
+    pairs = T["pairs"]
+    fig = Figure(figsize=(8.0, 1.0 + 1.6 * len(pairs)), layout="constrained")
+    axes = fig.subplots(len(pairs), 1, squeeze=False, sharex=True)[:, 0]
+    for ax, (a, b) in zip(axes, pairs):
+        rows = [r for r in T["cells"] if r["input"] == a and r["output"] == b]
+        fc = np.array([r["band_centre_hz"] for r in rows])
+        d = np.array([np.nan if r["log_ratio"] is None else r["log_ratio"] for r in rows])
+        lo = np.array([np.nan if r["ci_lo"] is None else r["ci_lo"] for r in rows])
+        hi = np.array([np.nan if r["ci_hi"] is None else r["ci_hi"] for r in rows])
+        sig = np.array([r["significant"] for r in rows])
+        ax.axhline(0, color="0.5", lw=0.8)
+        ax.fill_between(fc, lo, hi, color="C0", alpha=0.25, step="mid", label=f"{T['ci_level']:.3g} interval")
+        ax.plot(fc, d, "o-", color="C0", ms=3, lw=1, label="ln|H_sim| - ln|H_meas|")
+        ax.plot(fc[sig], d[sig], "o", color="C3", ms=6, mfc="none", label="flagged")
+        ax.set_xscale("log")
+        ax.set_ylabel("log ratio [-]", fontsize=8)
+        ax.set_title(f"transmissibility {a} -> {b}", fontsize=8)
+    axes[0].legend(fontsize=7, loc="best")
+    axes[-1].set_xlabel("third-octave band centre [Hz]")
+    fig.savefig(path, dpi=130)
+    return Path(path)
+
+
+def plot_ranking(summary: Mapping, path: str | os.PathLike) -> Path:
+    """Held-out gap of the nominal model and of each calibrated candidate (PNG).
+
+    Bars: mean over road-phase seeds; whiskers: seed range; grey band: nominal-vs-nominal
+    gap (mean +- 2 sd), the noise level.
+    """
+    R = summary["ranking"]
+    nom = summary["nominal"]
+    names = ["nominal"] + [r["effect"] for r in R]
+    vals = [nom["heldout_gap"]] + [r["heldout_gap_after"] for r in R]
+    per_seed = [nom["heldout_gap_per_seed"]] + [None] * len(R)
+    fig = Figure(figsize=(8.0, 1.2 + 0.3 * len(names)), layout="constrained")
+    ax = fig.add_subplot()
+    y = np.arange(len(names))
+    colors = ["0.4"] + [("C2" if r["accepted"] else "C0") for r in R]
+    ax.barh(y, vals, color=colors)
+    for i, r in enumerate(R, start=1):
+        s = r["heldout_gap_after_per_seed"]
+        ax.plot([min(s), max(s)], [i, i], color="k", lw=1)
+    b = np.array(per_seed[0])
+    ax.plot([b.min(), b.max()], [0, 0], color="k", lw=1)
+    m, sd = nom["null_gap_mean"], nom["null_gap_std"] or 0.0
+    ax.axvspan(m - 2 * sd, m + 2 * sd, color="0.8", alpha=0.6, label="nominal vs nominal (mean +- 2 sd)")
+    ax.set_yticks(y)
+    ax.set_yticklabels(names, fontsize=8)
+    ax.invert_yaxis()
+    ax.set_xlabel("held-out gap: weighted mean of ln(P_sim/P_meas)^2 [-]")
+    ax.set_title(f"verdict: {summary['verdict']} ({summary['verdict_confidence']}); green: accepted",
+                 fontsize=9)
+    ax.legend(fontsize=7, loc="lower right")
+    fig.savefig(path, dpi=130)
+    return Path(path)
+
+
+def plot_shrink_bands(summary: Mapping, path: str | os.PathLike) -> Path:
+    """Held-out gap per band before and after the winning (or best) effect (PNG)."""
+    H = summary["how_far"]
+    fc = np.array([r["band_centre_hz"] for r in H["per_band"]])
+    b = np.array([np.nan if r["gap_before"] is None else r["gap_before"] for r in H["per_band"]])
+    a = np.array([np.nan if r["gap_after"] is None else r["gap_after"] for r in H["per_band"]])
+    fig = Figure(figsize=(8.0, 3.2), layout="constrained")
+    ax = fig.add_subplot()
+    ax.plot(fc, b, "o-", color="0.3", ms=3, label="nominal model")
+    ax.plot(fc, a, "s-", color="C2", ms=3, label=f"with {H['effect']}")
+    ax.axhline(summary["nominal"]["noise_floor"], color="0.6", ls="--", lw=1,
+               label="noise floor (correct model)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("third-octave band centre [Hz]")
+    ax.set_ylabel("held-out gap per band [-]")
+    ax.set_title(f"how far: shrink {H['shrink_fraction']:.2f} +- {H['shrink_spread'] or 0:.2f} "
+                 f"(seeds); {H['effect']}", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.savefig(path, dpi=130)
+    return Path(path)
+
+
+# ----------------------------------------------------------------------------- markdown
+def _fmt(v, f="{:.3g}"):
+    return "-" if v is None else f.format(v)
+
+
+def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
+    """The readable report (Markdown) from a summary and figure file names."""
+    L = []
+    meta = summary.get("meta") or {}
+    L.append("# Sim-to-real gap diagnosis\n")
+    for k in ("dataset", "vehicle", "created", "command"):
+        if k in meta:
+            L.append(f"- {k}: `{meta[k]}`")
+    L.append("")
+    L.append("## Verdict\n")
+    v = summary["verdict"]
+    L.append(f"**{v}** (confidence: {summary['verdict_confidence']}). {summary['verdict_reason']}.\n")
+    H = summary.get("how_far")
+    if H and H["is_verdict"]:
+        L.append(f"Held-out gap {H['heldout_gap_before']:.3g} -> {H['heldout_gap_after']:.3g}: "
+                 f"shrink fraction {H['shrink_fraction']:.2f} +- {_fmt(H['shrink_spread'], '{:.2f}')} "
+                 f"across road-phase seeds (shrink of the part above sampling noise: "
+                 f"{_fmt(H['shrink_excess'], '{:.2f}')}).\n")
+    st = summary.get("localization_settings")
+    if st:
+        L.append("## Where the gap lies\n")
+        L.append(f"Log ratio of simulated to measured band power, ln(P_sim/P_meas), per channel, "
+                 f"third-octave band and segment. {st['n_flagged']} of {st['n_tested']} testable "
+                 f"cells are flagged (Benjamini-Hochberg, FDR q = {st['q']:g}; intervals at level "
+                 f"{st['ci_level']:.4g}, FCR-adjusted). +0.69 means the simulation has twice the "
+                 f"measured power.\n")
+        if "heatmap" in figures:
+            L.append(f"![heat map]({figures['heatmap']})\n")
+        top = sorted([r for r in summary["localization"] if r["significant"]],
+                     key=lambda r: -abs(r["log_psd_ratio"]))[:12]
+        if top:
+            L.append("Largest flagged gaps:\n")
+            L.append("| segment | channel | band [Hz] | ln ratio | interval | P_sim/P_meas |")
+            L.append("|---|---|---|---|---|---|")
+            for r in top:
+                L.append(f"| {r['segment']} | {r['channel']} | {r['band_hz'][0]:.3g}-{r['band_hz'][1]:.3g} "
+                         f"| {r['log_psd_ratio']:+.2f} | [{r['ci_lo']:+.2f}, {r['ci_hi']:+.2f}] "
+                         f"| {math.exp(r['log_psd_ratio']):.2f} |")
+            L.append("")
+        else:
+            L.append("No cell is flagged: the simulation agrees with the measurement within "
+                     "statistical noise.\n")
+        if "segments" in figures:
+            L.append(f"Per segment:\n\n![per segment]({figures['segments']})\n")
+    if summary.get("transmissibility") or summary.get("front_rear") or summary.get("distribution"):
+        L.append("## Road-independent comparisons\n")
+        L.append("These cancel the unknown road and isolate model error.\n")
+    T = summary.get("transmissibility")
+    if T:
+        L.append("**Axle-to-body transmissibility** (ln|H_sim| - ln|H_meas|):\n")
+        for a, b in T["pairs"]:
+            fl = [r["band_centre_hz"] for r in T["cells"] if r["input"] == a and r["output"] == b
+                  and r["significant"]]
+            L.append(f"- {a} -> {b}: " + (f"flagged at {', '.join(f'{f:.3g}' for f in fl)} Hz"
+                                          if fl else "no flagged band"))
+        L.append("")
+        if "transmissibility" in figures:
+            L.append(f"![transmissibility]({figures['transmissibility']})\n")
+    FR = summary.get("front_rear")
+    if FR:
+        L.append("**Front-to-rear delay** (GCC-SCOT; measured/simulated ratio with 95 % interval "
+                 "over time blocks; apparent speed scale = expected delay wheelbase/speed over "
+                 "measured delay):\n")
+        L.append("| front | rear | delay meas [s] | delay sim [s] | expected [s] | meas/sim | apparent speed scale | flagged |")
+        L.append("|---|---|---|---|---|---|---|---|")
+        for r in FR["delay"]:
+            ci = r["delay_ratio_ci95"]
+            sc = r["apparent_speed_scale_ci95"]
+            L.append(f"| {r['front']} | {r['rear']} | {_fmt(r['delay_meas_s'], '{:.4f}')} | "
+                     f"{_fmt(r['delay_sim_s'], '{:.4f}')} | {_fmt(r['delay_expected_s'], '{:.4f}')} | "
+                     f"{_fmt(r['delay_ratio_meas_over_sim'], '{:.3f}')} [{_fmt(ci[0], '{:.3f}')}, "
+                     f"{_fmt(ci[1], '{:.3f}')}] | {_fmt(r['apparent_speed_scale'], '{:.3f}')} "
+                     f"[{_fmt(sc[0], '{:.3f}')}, {_fmt(sc[1], '{:.3f}')}] | "
+                     f"{'yes' if r['significant'] else 'no'} |")
+        nco = sum(r["significant"] for r in FR["coherence"])
+        L.append(f"\nFront-to-rear coherence: {nco} flagged band(s).\n")
+    D = summary.get("distribution")
+    if D:
+        L.append("**Amplitude distributions** (excess kurtosis 0 for a Gaussian; KS distance between "
+                 "standardised distributions):\n")
+        L.append("| channel | skew meas | skew sim | kurtosis meas | kurtosis sim | KS distance | flagged |")
+        L.append("|---|---|---|---|---|---|---|")
+        for r in D:
+            L.append(f"| {r['channel']} | {r['skew_meas']:+.2f} | {r['skew_sim']:+.2f} | "
+                     f"{r['kurtosis_meas']:+.2f} | {r['kurtosis_sim']:+.2f} | {r['ks_distance']:.3f} | "
+                     f"{'yes' if r['significant'] else 'no'} |")
+        L.append("")
+    if summary.get("ranking"):
+        nom = summary["nominal"]
+        L.append("## Which effect\n")
+        L.append(f"Each candidate calibrated on calibration windows, scored on held-out windows "
+                 f"(gap = inverse-variance weighted mean of ln(P_sim/P_meas)^2 over channels, bands, "
+                 f"windows; mean over {len(nom['heldout_gap_per_seed'])} road-phase seeds). Nominal "
+                 f"held-out gap {nom['heldout_gap']:.3g}; a correct model would give "
+                 f"{nom['null_gap_mean']:.3g} +- {_fmt(nom['null_gap_std'], '{:.2g}')} "
+                 f"(nominal vs nominal). Accepted: improvement beyond 2 sd of that noise and lower BIC.\n")
+        L.append("| rank | effect | parameters | gap before | gap after | shrink | spread | dBIC | accepted |")
+        L.append("|---|---|---|---|---|---|---|---|---|")
+        for i, r in enumerate(summary["ranking"], 1):
+            par = "; ".join(f"{e}: " + ", ".join(f"{k}={v:.4g}" if isinstance(v, (int, float)) else f"{k}={v}"
+                                                 for k, v in p.items())
+                            for e, p in r["parameters"].items())
+            L.append(f"| {i} | {r['effect']} | {par} | {r['heldout_gap_before']:.3g} | "
+                     f"{r['heldout_gap_after']:.3g} | {r['shrink_fraction']:+.2f} | "
+                     f"{_fmt(r['shrink_spread'], '{:.2f}')} | {r['delta_bic']:+.1f} | "
+                     f"{'yes' if r['accepted'] else 'no'} |")
+        L.append("")
+        if "ranking" in figures:
+            L.append(f"![ranking]({figures['ranking']})\n")
+    if H:
+        L.append("## How far\n")
+        L.append(f"Held-out gap per band before and after {H['effect']}"
+                 + ("" if H["is_verdict"] else " (best candidate, NOT accepted)") + ".\n")
+        if "shrink" in figures:
+            L.append(f"![shrink per band]({figures['shrink']})\n")
+    L.append("## Method\n")
+    L.append("Band powers: Welch (Hann, 50 % overlap), exact equivalent degrees of freedom; "
+             "intervals from the F distribution of the ratio of two independent chi-square "
+             "estimates; flags by Benjamini-Hochberg. Time-history metrics (Sprague-Geers, Russell, "
+             "ISO 18571) are not used: the simulated road is a random-phase realisation, not the "
+             "measured one. See docs/diagnosis.md.\n")
+    return "\n".join(L)
+
+
+def write_report(out: str | os.PathLike, *, localization=None, transmissibility=None,
+                 front_rear=None, shape=None, ranking=None, meta: Mapping | None = None,
+                 force: bool = False) -> Path:
+    """Write ``summary.json``, ``figures/*.png`` and ``report.md`` into ``out``.
+
+    Parameters
+    ----------
+    out : path
+        Run folder; refused if it exists and is not empty unless ``force``.
+    localization, transmissibility, front_rear, shape, ranking, meta
+        As for :func:`build_summary`.
+    force : bool
+        Replace an existing non-empty ``out`` (only after the new one is complete).
+
+    Returns
+    -------
+    Path
+        ``out``.
+    """
+    out = Path(out)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())) and not force:
+        raise EroadInputError(f"{out} exists and is not empty (use --force to replace it)")
+    summary = build_summary(localization, transmissibility=transmissibility, front_rear=front_rear,
+                            shape=shape, ranking=ranking, meta=meta)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
+    try:
+        (tmp / "figures").mkdir()
+        figs = {}
+        if summary["localization"]:
+            figs["heatmap"] = "figures/heatmap.png"
+            plot_heatmap(summary, tmp / figs["heatmap"])
+            if len(summary["localization_settings"]["segments"]) > 1:
+                figs["segments"] = "figures/segments.png"
+                plot_segments(summary, tmp / figs["segments"])
+        if summary["transmissibility"]:
+            figs["transmissibility"] = "figures/transmissibility.png"
+            plot_transmissibility(summary, tmp / figs["transmissibility"])
+        if summary["ranking"]:
+            figs["ranking"] = "figures/ranking.png"
+            plot_ranking(summary, tmp / figs["ranking"])
+        if summary["how_far"]:
+            figs["shrink"] = "figures/shrink_per_band.png"
+            plot_shrink_bands(summary, tmp / figs["shrink"])
+        summary["figures"] = figs
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=1, allow_nan=False))
+        (tmp / "report.md").write_text(render_markdown(summary, figs))
+        if out.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
+            os.replace(out, old / out.name)
+            os.replace(tmp, out)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return out
