@@ -4,8 +4,10 @@ What it is for: the tests and the worked example of the callables that
 ``diagnosis.which`` needs (``fit`` and ``simulate``), with no Exudyn.  Front
 (axle 1) and rear (axle 3) corners of one side run over the same track, the rear
 one ``wheelbase`` later; each is a linear two-mass quarter-car (sprung and unsprung
-mass, suspension spring and damper, tyre spring) discretised exactly (zero-order
-hold) and run with ``scipy.signal.lfilter``; an optional cubic hardening spring
+mass, suspension spring and damper, tyre spring) discretised exactly for a
+piecewise-linear road input (first-order hold; a zero-order hold is badly wrong for
+the axle acceleration, whose tyre-force feedthrough then sees the road half a step
+early) and run with ``scipy.signal.lfilter``; an optional cubic hardening spring
 switches to a fixed-step RK4 integration.  Toy "effects" mimic the library's:
 
 ``tyre_stiffness.scale`` (k_t factor), ``payload.mass_scale`` (sprung-mass factor),
@@ -236,7 +238,7 @@ def simulate_drive(state: ToyState, duration: float, speed, seed, *, fs: float =
     if state.car.k3 != 0.0:
         y = _rk4_cubic(state.car, u, fs)
     else:
-        Ad, Bd, Cd, Dd, _ = signal.cont2discrete(_ss(state.car), 1.0 / fs, method="zoh")
+        Ad, Bd, Cd, Dd, _ = signal.cont2discrete(_ss(state.car), 1.0 / fs, method="foh")
         y = np.zeros((3, 2, u.shape[1]))
         for i in range(3):
             num, den = signal.ss2tf(Ad, Bd, Cd[i:i + 1], Dd[i:i + 1])

@@ -1,0 +1,212 @@
+"""The inverse-modelling pipeline on one record: segment, initialise, fit, diagnose.
+
+What it is for: one call that runs sections 2.2-2.4 of the paper on a drive given
+as arrays, with the response simulator supplied by the caller, and returns a
+result that serialises to the ``segments`` list of ``summary.json``.  What it is
+not: the command line, dataset reading, the global road (roadlib) or the Exudyn
+wiring (the caller's ``make_simulator``).
+
+Seeds: the fit's road phases come from one root seed,
+``SeedSequence(seed, spawn_key=(5, 1))`` (5 = issue/stage "inverse", 1 = fit
+phases), and the validation simulation's from ``spawn_key=(5, 2)``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from eroad.errors import EroadInputError
+from inverse.features import FeatureSet, FeatureSpec
+from inverse.segmentation import SegmentationResult, segment
+from inverse.sensitivity import FitConfig, FitResult, fit_segments
+from inverse.spectral import ParamBounds
+from inverse.validation import response_table
+
+#: spawn keys of the pipeline's random streams (see module docstring)
+SEED_KEY_FIT = (5, 1)
+SEED_KEY_VALIDATION = (5, 2)
+
+
+def stream_seed(seed: int, key: tuple) -> int:
+    """An int seed for one documented stream of a root seed."""
+    return int(np.random.SeedSequence(seed, spawn_key=key).generate_state(1)[0])
+
+
+@dataclass(frozen=True)
+class InversionConfig:
+    """Settings of :func:`invert`.
+
+    Parameters
+    ----------
+    k : int, optional
+        Number of segments; chosen by the segmentation's criterion when None.
+    segmentation : dict
+        Extra keyword arguments of :func:`inverse.segmentation.segment`.
+    feature_spec : FeatureSpec, optional
+        Features; default: all response channels present, other settings default.
+    fit : FitConfig
+    bounds : ParamBounds
+        Before the Nyquist cap (applied from the record).
+    w0, nmin0, nmax0 : float
+        Initial w [-], nmin and nmax [cycles/m] of every segment (the level comes
+        from the segmentation); also the prior mean.
+    seed : int
+        Root seed (see module docstring).
+    """
+
+    k: int | None = None
+    segmentation: dict = field(default_factory=dict)
+    feature_spec: FeatureSpec | None = None
+    fit: FitConfig = FitConfig()
+    bounds: ParamBounds = ParamBounds()
+    w0: float = 2.0
+    nmin0: float = 0.05
+    nmax0: float = 5.0
+    seed: int = 0
+
+
+@dataclass
+class Inversion:
+    """Result of :func:`invert`."""
+
+    time: np.ndarray
+    segmentation: SegmentationResult
+    features: FeatureSet
+    fit: FitResult
+    params0: np.ndarray
+    config: InversionConfig
+
+    @property
+    def t_bounds(self) -> np.ndarray:
+        return self.segmentation.t_bounds
+
+    def segments(self) -> list:
+        """Per-segment rows of summary.json (Table 1).
+
+        Returns
+        -------
+        list of dict
+            t_start, t_end [s], proportion [-], Gq_n0 [m^3], w [-], nmin, nmax
+            [cycles/m], dx, dy [m], class, initial_class, identifiable, sd,
+            objective, n_features, converged.
+        """
+        rows = []
+        tb = self.t_bounds
+        prop = self.segmentation.proportions
+        for k, s in enumerate(self.fit.segments):
+            d = s.as_dict()
+            rows.append({"t_start": float(tb[k]), "t_end": float(tb[k + 1]), "proportion": float(prop[k]),
+                         "Gq_n0": d["Gq_n0"], "w": d["w"], "nmin": d["nmin"], "nmax": d["nmax"],
+                         "dx": d["dx"], "dy": d["dy"], "class": d["class"],
+                         "initial_class": self.segmentation.classes[k],
+                         "identifiable": d["identifiable"], "sd": d["sd"], "objective": d["objective"],
+                         "n_features": d["n_features"], "converged": d["converged"]})
+        return rows
+
+    def summary(self) -> dict:
+        """JSON-ready summary: segments, fit statistics, iteration history."""
+        return {"segments": self.segments(),
+                "fit": {"n_sims": self.fit.n_sims, "wall_s": self.fit.wall_s,
+                        "iterations": len(self.fit.history) - 1,
+                        "objective": float(self.fit.history[-1]["objective"]),
+                        "n_features": int(self.features.n_features().sum())},
+                "segmentation": {"criterion": {str(k): float(v) for k, v in self.segmentation.criterion.items()}},
+                "history": self.fit.history}
+
+
+def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
+           segment_channels=None, config: InversionConfig = InversionConfig(),
+           map_fn=None, progress=None) -> Inversion:
+    """Segment a drive and fit the road spectrum of every segment.
+
+    Parameters
+    ----------
+    time : (N,) array
+        Uniform time [s].
+    channels : dict
+        Channel name -> (N,) array, SI units (shared/docs/measurement-format.md).
+    speed : float or (N,) array
+        [m/s].
+    make_simulator : callable
+        ``make_simulator(t_bounds) -> simulate``: given the K + 1 segment
+        boundaries [s] on ``time``, a simulator with the contract of
+        :mod:`inverse.sensitivity` (``simulate(params (K, 4), seed) -> dict``).
+    predict_rms : callable, optional
+        ``predict_rms(Gq_n0, w, speed) -> rms`` of the segmentation channels'
+        displacement in the segmentation's ``class_band`` (see
+        :func:`inverse.segmentation.segment`); without it every segment starts at
+        class C.
+    segment_channels : list of str, optional
+        Displacement channels to segment on; default all ``susp_disp_3*``, else
+        all ``susp_disp_*``.
+    config : InversionConfig
+    map_fn : callable, optional
+        Parallel map for the sampled simulations (see :func:`fit_segments`).
+    progress : callable, optional
+        Called with each fit history entry.
+
+    Returns
+    -------
+    Inversion
+    """
+    t = np.asarray(time, dtype=float)
+    if segment_channels is None:
+        segment_channels = sorted(c for c in channels if c.startswith("susp_disp_3")) or \
+            sorted(c for c in channels if c.startswith("susp_disp_"))
+    if not segment_channels:
+        raise EroadInputError("invert: no suspension displacement channel (susp_disp_*) to segment on")
+    seg = segment(t, {c: channels[c] for c in segment_channels}, speed, k=config.k,
+                  predict_rms=predict_rms, w_init=config.w0, **config.segmentation)
+    spec = config.feature_spec
+    if spec is None:
+        names = sorted(c for c in channels if c.split("_")[0] in ("susp", "axle", "body"))
+        spec = FeatureSpec(channels=tuple(names))
+    feats = FeatureSet.from_measurement(t, channels, seg.t_bounds, spec)
+    K = seg.n_segments
+    Gq0 = np.where(np.isfinite(seg.Gq_init), seg.Gq_init, 256e-6)
+    params0 = np.column_stack([Gq0, np.full(K, config.w0), np.full(K, config.nmin0), np.full(K, config.nmax0)])
+    fs = 1.0 / float(np.mean(np.diff(t)))
+    v_max = float(np.max(np.broadcast_to(np.asarray(speed, float), t.shape)))
+    bounds = config.bounds.for_record(fs, v_max)
+    simulate = make_simulator(seg.t_bounds)
+    fit = fit_segments(simulate, feats, params0, seed=stream_seed(config.seed, SEED_KEY_FIT),
+                       bounds=bounds, config=config.fit, map_fn=map_fn, progress=progress)
+    return Inversion(t, seg, feats, fit, params0, config)
+
+
+def validate(simulate, params, measured: dict, channels, seed: int = 0) -> tuple:
+    """Simulate the identified road once and compare with the measurement.
+
+    Parameters
+    ----------
+    simulate : callable
+        Simulator (contract of :mod:`inverse.sensitivity`).
+    params : (K, 4) array
+        Fitted parameters.
+    measured : dict
+        Channel -> (N,) array.
+    channels : list of str
+    seed : int
+        Root seed; the phases use the stream ``SEED_KEY_VALIDATION``.
+
+    Returns
+    -------
+    simulated : dict
+        Channel -> (N,) array.
+    table : list of dict
+        :func:`inverse.validation.response_table` rows.
+    """
+    sim = simulate(np.asarray(params, dtype=float), stream_seed(seed, SEED_KEY_VALIDATION))
+    return sim, response_table(measured, sim, channels)
+
+
+def segment_errors(t_true, t_found) -> np.ndarray:
+    """Boundary errors [s]: for each interior true boundary, the signed distance
+    to the nearest interior found boundary (nan when none was found)."""
+    tt = np.asarray(t_true, dtype=float)[1:-1]
+    tf = np.asarray(t_found, dtype=float)[1:-1]
+    if tf.size == 0:
+        return np.full(tt.size, math.nan)
+    return np.array([tf[np.argmin(np.abs(tf - b))] - b for b in tt])

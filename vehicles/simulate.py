@@ -1,0 +1,560 @@
+"""Drive a vehicle model over a road: the time simulation and its outputs.
+
+What it is for: :func:`simulate` takes a vehicle, a :class:`roadlib.surface.RoadSurface`,
+a speed (constant or a :class:`SpeedProfile`), effects, and returns a
+:class:`vehicles.result.SimResult` with the measurement channels at 200 Hz.  It is the
+simulator the virtual test drive, the inverse fit and the gap diagnosis call, many
+times, so it is built for speed:
+
+* the road height under every tyre is computed for the whole time grid at once
+  (vectorised bilinear interpolation), and turned into two road loads per axle
+  (vertical force and roll moment, see :mod:`vehicles.builder`);
+* one Python ``PreStep`` callback per step only indexes those arrays and sets the
+  loads; everything else runs in Exudyn's C++;
+* the linear model (no nonlinear effect) is integrated with the implicit
+  generalized-alpha method as a linear implicit scheme (one solve per step with the
+  Jacobian factorised once); nonlinear effects switch Newton iterations on;
+* outputs come from world-frame node sensors stored in memory and are turned into
+  point motions by rigid-body kinematics in numpy afterwards.
+
+What it is not: the model (:mod:`vehicles.builder`), the effects
+(:mod:`vehicles.effects`) or the dataset writer (:mod:`drives.format`).
+
+Kinematics: the vehicle stays at x = 0 and the road moves under it.  The first axle
+is at road position ``x_start + s(t)`` with ``s(t)`` the integral of the speed, axle
+``a`` at ``x_start + s(t) + axle.x`` (``axle.x <= 0``), so each axle sees the road
+delayed by its distance to the first axle.  A tyre at vehicle lateral position ``y``
+runs on road lateral position ``y_offset + y`` (y positive to the left).
+"""
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass
+
+import numpy as np
+
+from eroad.errors import EroadInputError, SimulationError
+from vehicles.builder import SIDE_SIGN, SIDES, build_model
+from vehicles.effects import EFFECTS, resolve_effects
+from vehicles.effects.base import Effect, EffectContext
+from vehicles.params import VehicleParams, load_vehicle
+from vehicles.result import SimResult, unit_of
+
+#: channels larger than this [m] or [m/s^2] mean the solution diverged
+DIVERGENCE_LIMIT = {"susp_disp": 2.0, "axle_acc": 5e3, "body_acc": 5e3}
+
+
+@dataclass(frozen=True)
+class SpeedProfile:
+    """Vehicle speed as a piecewise-linear function of time.
+
+    Parameters
+    ----------
+    t : array_like (n,)
+        Times [s], strictly increasing, starting at or before 0.
+    v : array_like (n,)
+        Speeds [m/s], all > 0.
+
+    Raises
+    ------
+    EroadInputError
+        Non-increasing times, non-positive or non-finite speeds, fewer than 2 points.
+    """
+
+    t: np.ndarray
+    v: np.ndarray
+
+    def __post_init__(self):
+        t = np.asarray(self.t, float).ravel()
+        v = np.asarray(self.v, float).ravel()
+        if t.size != v.size or t.size < 2:
+            raise EroadInputError("speed profile: t and v need the same length >= 2")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
+            raise EroadInputError("speed profile: t and v must be finite")
+        bad = np.nonzero(np.diff(t) <= 0)[0]
+        if bad.size:
+            raise EroadInputError(f"speed profile: time not strictly increasing at row {bad[0] + 2}")
+        if np.any(v <= 0):
+            i = int(np.nonzero(v <= 0)[0][0])
+            raise EroadInputError(f"speed profile: speed must be > 0 m/s, got {v[i]:g} at t = {t[i]:g} s")
+        if t[0] > 0:
+            raise EroadInputError(f"speed profile: must start at t <= 0, starts at {t[0]:g} s")
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "v", v)
+
+    def speed(self, tq) -> np.ndarray:
+        """Speed [m/s] at times ``tq`` [s] (linear interpolation)."""
+        return np.interp(tq, self.t, self.v)
+
+    def distance(self, tq) -> np.ndarray:
+        """Distance travelled since t = 0 [m] at times ``tq`` (exact integral of the
+        piecewise-linear speed)."""
+        return self._abs_distance(np.asarray(tq, float)) - self._abs_distance(np.array(0.0))
+
+    def _abs_distance(self, tq):
+        seg = np.diff(self.t) * 0.5 * (self.v[1:] + self.v[:-1])
+        S = np.concatenate([[0.0], np.cumsum(seg)])
+        i = np.clip(np.searchsorted(self.t, tq, side="right") - 1, 0, self.t.size - 2)
+        tau = tq - self.t[i]
+        slope = (self.v[i + 1] - self.v[i]) / (self.t[i + 1] - self.t[i])
+        return S[i] + self.v[i] * tau + 0.5 * slope * tau ** 2
+
+    @property
+    def t_end(self) -> float:
+        return float(self.t[-1])
+
+    @classmethod
+    def constant(cls, v: float, duration: float) -> "SpeedProfile":
+        """A constant speed ``v`` [m/s] over ``[0, duration]`` [s]."""
+        v = float(v)
+        if not (math.isfinite(v) and v > 0):
+            raise EroadInputError(f"speed must be > 0 m/s, got {v!r}")
+        return cls(np.array([0.0, float(duration)]), np.array([v, v]))
+
+    @classmethod
+    def from_csv(cls, path) -> "SpeedProfile":
+        """Read a CSV with a header and columns ``time`` [s] and ``speed`` [m/s].
+
+        Raises
+        ------
+        EroadInputError
+            Missing file or columns, values that are not numbers (file, column, row).
+        """
+        import pandas as pd
+        from pathlib import Path
+
+        path = Path(path)
+        if not path.is_file():
+            raise EroadInputError(f"{path}: no such speed-profile file")
+        try:
+            df = pd.read_csv(path)
+        except Exception as exc:  # noqa: BLE001 - pandas raises many types
+            raise EroadInputError(f"{path}: not a readable CSV ({exc})") from None
+        cols = {c.strip().lower(): c for c in df.columns}
+        tc = cols.get("time", cols.get("t"))
+        vc = cols.get("speed", cols.get("v"))
+        if tc is None or vc is None:
+            raise EroadInputError(f"{path}: needs columns 'time' [s] and 'speed' [m/s], "
+                                  f"has {', '.join(map(str, df.columns))}")
+        for c in (tc, vc):
+            vals = pd.to_numeric(df[c], errors="coerce")
+            if vals.isna().any():
+                row = int(np.nonzero(vals.isna().to_numpy())[0][0]) + 2
+                raise EroadInputError(f"{path}: column {c}, row {row}: not a number")
+        try:
+            return cls(df[tc].to_numpy(float), df[vc].to_numpy(float))
+        except EroadInputError as exc:
+            raise EroadInputError(f"{path}: {exc}") from None
+
+
+def _speed_profile(speed, duration) -> SpeedProfile:
+    if isinstance(speed, SpeedProfile):
+        if speed.t_end < duration - 1e-9:
+            raise EroadInputError(f"speed profile ends at t = {speed.t_end:g} s, before the "
+                                  f"duration {duration:g} s")
+        return speed
+    try:
+        v = float(speed)
+    except (TypeError, ValueError):
+        raise EroadInputError(f"speed must be a number [m/s] or a SpeedProfile, got {speed!r}") from None
+    return SpeedProfile.constant(v, duration)
+
+
+def output_points(model):
+    """Body-fixed points behind the output channels.
+
+    Returns
+    -------
+    list of (channel, kind, body name, design world point (3,))
+        kind is ``"z_pos"`` (vertical position), ``"z_acc"`` (vertical acceleration) or
+        ``"yz_pos"`` (DCDC points: lateral and vertical position).
+    """
+    vp = model.vp
+    pts = []
+    for s in model.suspensions:
+        a = s.axle
+        ax = vp.axles[a]
+        seg = model.segments[s.segment].name
+        tag = f"{a + 1}{s.side}"
+        pts.append((f"seat_axle_{tag}", "z_pos", model.axles[a].name, s.point))
+        pts.append((f"seat_body_{tag}", "z_pos", seg, s.point))
+        end = np.array([ax.x, SIDE_SIGN[s.side] * ax.track / 2, ax.tyre_radius])
+        pts.append((f"axle_acc_{tag}", "z_acc", model.axles[a].name, end))
+        pts.append((f"body_acc_{tag}", "z_acc", seg, s.point))
+    if vp.dcdc is not None:
+        d = vp.dcdc
+        for k, (sx, sy) in enumerate(((1, 1), (1, -1), (-1, -1), (-1, 1)), start=1):
+            p = np.array([d.x + sx * d.point_x, d.y + sy * d.point_y, d.z_base + d.height])
+            pts.append((f"P{k}", "yz_pos", "dcdc", p))
+    return pts
+
+
+def _static_point(model, body_name, world_point):
+    b = model.body(body_name)
+    p0, R0 = model.static[body_name]
+    return p0 + R0 @ (np.asarray(world_point) - b.cog)
+
+
+def _sensor_arrays(model, name, n):
+    mbs = model.mbs
+    out = {}
+    for key, s in model.sensors[name].items():
+        d = np.asarray(mbs.GetSensorStoredData(s))
+        out[key] = d[:, 1:]
+        out["t"] = d[:, 0]
+    out["RotationMatrix"] = out["RotationMatrix"].reshape(-1, 3, 3)
+    return out
+
+
+def _point_kinematics(data, local):
+    """World position and acceleration of a body-fixed point from node outputs."""
+    d = np.einsum("nij,j->ni", data["RotationMatrix"], local)
+    pos = data["Position"] + d
+    w, al = data["AngularVelocity"], data["AngularAcceleration"]
+    acc = data["Acceleration"] + np.cross(al, d) + np.cross(w, np.cross(w, d))
+    return pos, acc
+
+
+def _small_rotation(R, R0):
+    M = np.einsum("nij,kj->nik", R, R0)    # R R0^T
+    return np.stack([0.5 * (M[:, 2, 1] - M[:, 1, 2]), 0.5 * (M[:, 0, 2] - M[:, 2, 0]),
+                     0.5 * (M[:, 1, 0] - M[:, 0, 1])], axis=1)
+
+
+def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effects=None,
+             dt: float | None = None, fs_out: float = 200.0, x_start: float | None = None,
+             y_offset: float = 0.0, seed: int | None = None, frame_segments: int | None = None,
+             newton: bool | None = None) -> SimResult:
+    """Simulate a vehicle driving over a road.
+
+    Parameters
+    ----------
+    vehicle : str or Path or VehicleParams
+        Built-in id, TOML file or parameters.
+    road : roadlib.surface.RoadSurface
+        Must cover the drive: from the last axle at ``t = 0`` to the first axle at
+        ``t = duration`` (plus half a tyre footprint when enveloping is on).
+    speed : float or SpeedProfile
+        Constant speed [m/s] (> 0) or a profile covering ``[0, duration]``.
+    duration : float
+        Simulated time [s].
+    chassis : {"rigid", "flexible"}
+        Frame model; the ``frame_flex`` effect also switches to flexible.
+    effects : dict or list of str, optional
+        ``{name: value | {param: value}}`` or ``["NAME=VALUE", ...]``; off by default.
+    dt : float, optional
+        Time step [s]; default ``vehicle.solver.dt``, rounded so that the output period
+        ``1/fs_out`` is a whole number of steps.
+    fs_out : float
+        Output sample rate [Hz].
+    x_start : float, optional
+        Road position of the first axle at ``t = 0`` [m]; default: the last axle at
+        the start of the road (plus half a footprint).
+    y_offset : float
+        Road lateral position of the vehicle centre line [m].
+    seed : int, optional
+        Root seed for random effects (sensor noise); default 0.
+    frame_segments : int, optional
+        Segments of the flexible frame (default ``vehicle.frame.segments``).
+    newton : bool, optional
+        Force (True) or suppress (False) Newton iterations; default: only with
+        nonlinear effects.
+
+    Returns
+    -------
+    SimResult
+
+    Raises
+    ------
+    EroadInputError
+        Bad input, refused before simulating: missing vehicle file, speed <= 0, road
+        shorter than the drive or narrower than the vehicle, unknown effect.
+    SimulationError
+        The solver failed or diverged; the message names the simulated time and the
+        likely cause.
+    """
+    wall0 = _time.perf_counter()
+    exu = __import__("exudyn")
+    vp0: VehicleParams = load_vehicle(vehicle)
+    try:
+        duration = float(duration)
+        fs_out = float(fs_out)
+    except (TypeError, ValueError):
+        raise EroadInputError("duration and fs_out must be numbers") from None
+    if not (math.isfinite(duration) and duration > 0):
+        raise EroadInputError(f"duration must be > 0 s, got {duration!r}")
+    if not (math.isfinite(fs_out) and fs_out > 0):
+        raise EroadInputError(f"fs_out must be > 0 Hz, got {fs_out!r}")
+    if chassis not in ("rigid", "flexible"):
+        raise EroadInputError(f"chassis must be 'rigid' or 'flexible', got {chassis!r}")
+    profile = _speed_profile(speed, duration)
+    eff = resolve_effects(effects)
+    seed = 0 if seed is None else int(seed)
+
+    # ---- time grid
+    t_out = 1.0 / fs_out
+    dt_req = float(dt) if dt is not None else vp0.solver.dt
+    if not (math.isfinite(dt_req) and dt_req > 0):
+        raise EroadInputError(f"dt must be > 0 s, got {dt!r}")
+    if dt_req > t_out * (1 + 1e-9):
+        raise EroadInputError(f"dt = {dt_req:g} s exceeds the output period 1/fs_out = {t_out:g} s")
+    n_sub = max(1, int(round(t_out / dt_req)))
+    dt = t_out / n_sub
+    n_steps = int(round(duration / dt))
+    n_out = int(round(duration * fs_out)) + 1
+    t_steps = np.arange(n_steps + 1) * dt
+
+    # ---- effects: configuration and road
+    ctx = EffectContext(vp=vp0, reference_vp=vp0, chassis=chassis, frame_segments=frame_segments,
+                        fs_out=fs_out, dt=dt, seed=seed)
+    for name, p in eff.items():
+        EFFECTS[name].configure(ctx, p)
+    vp = ctx.vp
+    road_used = road
+    for name, p in eff.items():
+        road_used = EFFECTS[name].road(road_used, p, ctx)
+
+    # ---- road coverage (refuse before simulating)
+    xs_axle = np.array([a.x for a in vp.axles])
+    margin = 0.5 * max([a.tyre_contact_length for a in vp.axles] + [0.0]) \
+        if "tyre_enveloping" in eff else 0.0
+    if "tyre_enveloping" in eff:
+        margin = max(margin, 0.5 * eff["tyre_enveloping"].get("length", 0.0))
+    if x_start is None:
+        x_start = road.x_min - xs_axle.min() + margin + 1e-9
+    x_start = float(x_start)
+    s_steps = profile.distance(t_steps)
+    need_lo = x_start + xs_axle.min() - margin
+    need_hi = x_start + s_steps[-1] + margin
+    if need_lo < road.x_min - 1e-9 or need_hi > road.x_max + 1e-9:
+        raise EroadInputError(
+            f"road too short: the drive needs x from {need_lo:.2f} to {need_hi:.2f} m, the road "
+            f"covers {road.x_min:.2f} to {road.x_max:.2f} m (duration {duration:g} s, distance "
+            f"{s_steps[-1]:.1f} m)")
+
+    # ---- model
+    terms_of = None
+    if any(type(EFFECTS[n]).suspension_terms is not Effect.suspension_terms for n in eff):
+        def terms_of(susp):
+            out = []
+            for n, p in eff.items():
+                out += list(EFFECTS[n].suspension_terms(susp, p, ctx) or [])
+            return out
+    model = build_model(vp, chassis=ctx.chassis, frame_segments=ctx.frame_segments,
+                        stiffness_factor=ctx.stiffness_factor, suspension_terms=terms_of)
+    if road.y.size > 1:
+        ys = y_offset + np.array([c.y for c in model.contacts])
+        if ys.min() < road.y[0] - 1e-9 or ys.max() > road.y[-1] + 1e-9:
+            raise EroadInputError(
+                f"road too narrow: tyres run at y from {ys.min():.2f} to {ys.max():.2f} m, the road "
+                f"covers {road.y[0]:.2f} to {road.y[-1]:.2f} m")
+    ref_model = model
+    if ctx.reference_vp is not vp:
+        ref_model = build_model(ctx.reference_vp, chassis=ctx.chassis,
+                                frame_segments=ctx.frame_segments,
+                                stiffness_factor=ctx.stiffness_factor)
+
+    # ---- road input on the step grid
+    nc = len(model.contacts)
+    xc = x_start + s_steps[:, None] + np.array([vp.axles[c.axle].x for c in model.contacts])[None, :]
+    yc = y_offset + np.array([c.y for c in model.contacts])[None, :]
+    zr = road_used.height(xc, np.broadcast_to(yc, xc.shape))
+    zr_t = np.gradient(zr, dt, axis=0) if n_steps >= 2 else np.zeros_like(zr)
+    kc = np.array([c.stiffness for c in model.contacts])
+    cc = np.array([c.damping for c in model.contacts])
+    f_c = zr * kc + zr_t * cc
+    Bf, Bt = model.road_force_matrices()
+    F = f_c @ Bf.T
+    T = f_c @ Bt.T
+    # start at static equilibrium on the road under the tyres at t = 0
+    model.set_road_forces((zr[0] * kc) @ Bf.T, (zr[0] * kc) @ Bt.T)
+    model.solve_static()
+
+    loads = [(lf, lt, F[:, a].tolist(), T[:, a].tolist()) for a, (lf, lt) in enumerate(model.road_loads)]
+    inv_dt = 1.0 / dt
+    kmax = n_steps
+    set_load = model.mbs.SetLoadParameter
+
+    def prestep(mbs, t):
+        k = int(t * inv_dt + 0.5)
+        if k > kmax:
+            k = kmax
+        for lf, lt, fa, ta in loads:
+            set_load(lf, "loadVector", [0.0, 0.0, fa[k]])
+            set_load(lt, "loadVector", [ta[k], 0.0, 0.0])
+        return True
+
+    model.mbs.SetPreStepUserFunction(prestep)
+    nonlinear = any(EFFECTS[n].nonlinear for n in eff) if newton is None else bool(newton)
+    s = exu.SimulationSettings()
+    ti = s.timeIntegration
+    ti.numberOfSteps = n_steps
+    ti.startTime = 0.0
+    ti.endTime = n_steps * dt
+    ti.verboseMode = 0
+    ti.generalizedAlpha.spectralRadius = vp.solver.spectral_radius
+    ti.generalizedAlpha.computeInitialAccelerations = True
+    ti.newton.useModifiedNewton = True
+    ti.newton.active = nonlinear
+    ti.newton.relativeTolerance = 1e-5
+    ti.newton.absoluteTolerance = 1e-6
+    ti.newton.modifiedNewtonJacUpdatePerStep = False
+    s.solution.file.write = False
+    s.solution.sensors.writePeriod = t_out
+    s.show.computationTime = False
+
+    solver = exu.MainSolverImplicitSecondOrder()
+    solve0 = _time.perf_counter()
+    ok, err = False, ""
+    from vehicles.builder import _quiet
+    try:
+        with _quiet():
+            ok = solver.SolveSystem(model.mbs, s)
+    except Exception as exc:  # noqa: BLE001 - Exudyn raises several types
+        err = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    solve_s = _time.perf_counter() - solve0
+    t_fail = float(solver.it.currentTime)
+    if not ok:
+        raise SimulationError(_failure_message(t_fail, duration, eff, dt, err))
+    steps = int(solver.it.currentStepIndex) - 1
+
+    # ---- outputs
+    data = {b.name: _sensor_arrays(model, b.name, n_out) for b in model.bodies}
+    ts = data[model.segments[0].name]["t"]
+    keep = np.nonzero(np.abs(ts[:, None] - np.arange(n_out)[None, :] * t_out).min(axis=1) < 0.25 * dt)[0]
+    # stored rows: the initial state and every output period; take one row per output time
+    rows = []
+    for j in range(n_out):
+        hit = keep[np.abs(ts[keep] - j * t_out) < 0.25 * dt]
+        if hit.size == 0:
+            raise SimulationError(f"no output stored at t = {j * t_out:.4f} s (simulated up to "
+                                  f"{t_fail:.3f} s); likely cause: the solver stopped early")
+        rows.append(hit[-1])
+    rows = np.array(rows)
+    for name in data:
+        for key in data[name]:
+            data[name][key] = data[name][key][rows]
+    time = np.arange(n_out) * t_out
+
+    channels, units = {}, {}
+    pos = {}
+    for ch, kind, body, wp in output_points(model):
+        b = model.body(body)
+        local = np.asarray(wp) - b.cog
+        p, a = _point_kinematics(data[body], local)
+        p_ref = _static_point(ref_model, body, wp)
+        if kind == "z_pos":
+            pos[ch] = p[:, 2] - p_ref[2]
+        elif kind == "z_acc":
+            channels[ch] = a[:, 2]
+        else:
+            pos[ch] = p - p_ref
+    ordered = {}
+    for a, ax in enumerate(vp.axles):
+        for side in SIDES:
+            tag = f"{a + 1}{side}"
+            ordered[f"susp_disp_{tag}"] = pos[f"seat_axle_{tag}"] - pos[f"seat_body_{tag}"]
+    for a, ax in enumerate(vp.axles):
+        for side in SIDES:
+            ordered[f"axle_acc_{a + 1}{side}"] = channels[f"axle_acc_{a + 1}{side}"]
+    for a, ax in enumerate(vp.axles):
+        for side in SIDES:
+            ordered[f"body_acc_{a + 1}{side}"] = channels[f"body_acc_{a + 1}{side}"]
+    extra = {}
+    if vp.dcdc is not None:
+        for k in range(1, 5):
+            ordered[f"dcdc_y_P{k}"] = pos[f"P{k}"][:, 1]
+        for k in range(1, 5):
+            ordered[f"dcdc_z_P{k}"] = pos[f"P{k}"][:, 2]
+        extra.update(_dcdc_reference(model, ref_model, data["dcdc"]))
+    ordered["speed"] = profile.speed(time)
+    channels = ordered
+    _check_divergence(channels, time, eff, dt, duration)
+
+    # tyre forces (dynamic part) and lift-off
+    k_out = np.arange(n_out) * n_sub
+    zr_o, zr_t_o = zr[k_out], zr_t[k_out]
+    zc = np.empty((n_out, nc))
+    for c, ct in enumerate(model.contacts):
+        ab = model.axles[ct.axle]
+        p, _ = _point_kinematics(data[ab.name], ct.local)
+        zc[:, c] = p[:, 2] - _static_point(model, ab.name, ab.cog + ct.local)[2]
+    zc_t = np.gradient(zc, t_out, axis=0)
+    f_dyn = kc * (zr_o - zc) + cc * (zr_t_o - zc_t)
+    f_static = model.static_tyre_loads()
+    lift = np.any(f_static[None, :] + f_dyn < 0, axis=1)
+    extra["road_z"] = zr_o
+    extra["tyre_force"] = f_dyn
+
+    meta_eff = {n: dict(p) for n, p in eff.items()}
+    for name, p in eff.items():
+        EFFECTS[name].outputs(time, channels, p, ctx)
+    units = {n: unit_of(n) for n in channels}
+    wall = _time.perf_counter() - wall0
+    meta = {
+        "vehicle": vp0.id, "vehicle_name": vp0.name, "chassis": model.chassis,
+        "frame_segments": len(model.segments) if model.chassis == "flexible" else 1,
+        "frame_stiffness_factor": model.stiffness_factor,
+        "effects": meta_eff, "effect_notes": dict(ctx.notes),
+        "dt": dt, "fs_out": fs_out, "duration": duration, "steps": steps,
+        "wall_s": wall, "solve_s": solve_s, "realtime_factor": duration / wall,
+        "n_dof": model.n_dof, "n_bodies": len(model.bodies), "newton": nonlinear,
+        "speed_mean": float(np.mean(profile.speed(time))), "distance_m": float(s_steps[-1]),
+        "x_start": x_start, "y_offset": float(y_offset), "seed": seed,
+        "tyre_lift_off_fraction": float(lift.mean()),
+        "road": {k: v for k, v in (getattr(road, "meta", {}) or {}).items()
+                 if isinstance(v, (int, float, str, bool))},
+        "exudyn_version": exu.__version__,
+    }
+    return SimResult(time=time, channels=channels, units=units, meta=meta, extra=extra, vehicle=vp)
+
+
+def _dcdc_reference(model, ref_model, data) -> dict:
+    d = model.vp.dcdc
+    top = np.array([d.x, d.y, d.z_base + d.height])
+    b = model.body("dcdc")
+    pos, acc = _point_kinematics(data, top - b.cog)
+    p_ref = _static_point(ref_model, "dcdc", top)
+    R0 = ref_model.static["dcdc"][1]
+    rot = _small_rotation(data["RotationMatrix"], R0)
+    pts = np.array([[sx * d.point_x, sy * d.point_y, 0.0]
+                    for sx, sy in ((1, 1), (1, -1), (-1, -1), (-1, 1))])
+    return {"dcdc_ref": np.hstack([pos - p_ref, rot]),
+            "dcdc_ref_acc": np.hstack([acc, data["AngularAcceleration"]]),
+            "dcdc_ref_vel": data["AngularVelocity"].copy(),
+            "dcdc_points": pts,
+            "dcdc_ref_columns": np.array(["Tx", "Ty", "Tz", "Rx", "Ry", "Rz"])}
+
+
+def _likely_cause(eff, dt) -> str:
+    stiff = [n for n in ("bump_stop", "leaf_friction", "damper_asymmetry") if n in eff]
+    if stiff:
+        return (f"the nonlinear effect(s) {', '.join(stiff)} are too stiff for the time step "
+                f"dt = {dt:g} s (smaller dt, softer bump stop or larger friction velocity)")
+    return (f"the time step dt = {dt:g} s is too large for the stiffest element, or the road is "
+            "far too rough for the model (check the road's units: metres)")
+
+
+def _failure_message(t_fail, duration, eff, dt, err) -> str:
+    detail = f" ({err})" if err else ""
+    return (f"solver failed at simulated time t = {t_fail:.3f} s of {duration:g} s{detail}; "
+            f"likely cause: {_likely_cause(eff, dt)}")
+
+
+def _check_divergence(channels, time, eff, dt, duration):
+    for name, x in channels.items():
+        prefix = name.rsplit("_", 1)[0]
+        lim = DIVERGENCE_LIMIT.get(prefix)
+        if lim is None:
+            if not np.all(np.isfinite(x)):
+                bad = np.nonzero(~np.isfinite(x))[0][0]
+                raise SimulationError(f"{name} is not finite from t = {time[bad]:.3f} s; likely "
+                                      f"cause: {_likely_cause(eff, dt)}")
+            continue
+        badmask = ~np.isfinite(x) | (np.abs(x) > lim)
+        if badmask.any():
+            bad = int(np.nonzero(badmask)[0][0])
+            raise SimulationError(
+                f"solution diverged at simulated time t = {time[bad]:.3f} s of {duration:g} s "
+                f"({name} = {x[bad]:.3g}); likely cause: {_likely_cause(eff, dt)}")
