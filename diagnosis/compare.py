@@ -57,7 +57,7 @@ from eroad.errors import EroadInputError
 
 from .bandpower import band_nperseg, third_octave_bands, welch_edof
 from .fdr import benjamini_hochberg, fcr_level
-from .signals import Signals, as_signals
+from .signals import as_signals
 
 __all__ = ["Transmissibility", "transmissibility", "FrontRear", "front_rear", "Shape",
            "distribution_shape", "sprague_geers", "russell", "gcc_delay"]
@@ -532,7 +532,8 @@ class Shape:
         """JSON-ready list, one dict per channel."""
         out = []
         for i, c in enumerate(self.channels):
-            out.append({"channel": c, "skew_meas": _num(self.skew_meas[i]), "skew_sim": _num(self.skew_sim[i]),
+            out.append({"channel": c, "skew_meas": _num(self.skew_meas[i]),
+                        "skew_sim": _num(self.skew_sim[i]),
                         "kurtosis_meas": _num(self.kurt_meas[i]), "kurtosis_sim": _num(self.kurt_sim[i]),
                         "se_skew": _num(self.se_skew[i]), "se_kurtosis": _num(self.se_kurt[i]),
                         "ks_distance": _num(self.ks_distance[i]), "p_skew": _num(self.p_skew[i]),
@@ -650,7 +651,8 @@ def distribution_shape(measured, simulated, *, channels: Sequence[str] | None = 
     p_s = 2 * stats.norm.sf(np.abs(ss - sm) / se_s)
     p_k = 2 * stats.norm.sf(np.abs(ks - km) / se_k)
     sig = benjamini_hochberg(np.vstack([p_s, p_k, pks]), q)
-    return Shape(names, sm, ss, km, ks, se_s, se_k, D, nm, ns, p_s, p_k, pks, sig[0], sig[1], sig[2], float(q))
+    return Shape(names, sm, ss, km, ks, se_s, se_k, D, nm, ns, p_s, p_k, pks, sig[0], sig[1], sig[2],
+                 float(q))
 
 
 # ----------------------------------------------------------------------------- time-history metrics

@@ -35,7 +35,7 @@ import numpy as np
 from eroad.errors import EroadInputError
 
 from .bandpower import BandSpectrum, band_powers, third_octave_bands, var_log_power
-from .signals import Signals, as_signals
+from .signals import as_signals
 
 __all__ = ["Gap", "Reference", "reference", "band_gap"]
 
@@ -52,6 +52,8 @@ class Gap:
         The same per band (NaN where no cell).
     floor : float, (log units)^2
         Expected ``value`` for a correct model (sampling noise only).
+    per_band_floor : (nb,) array, (log units)^2
+        The same per band.
     n_cells : int
     bands : (nb, 3) array, Hz
     log_ratio : (nwin, nch, nb) array
@@ -63,6 +65,7 @@ class Gap:
     value: float
     per_band: np.ndarray
     floor: float
+    per_band_floor: np.ndarray
     n_cells: int
     bands: np.ndarray
     log_ratio: np.ndarray
@@ -165,6 +168,7 @@ def band_gap(simulated: Sequence, ref: Reference) -> Gap:
     swb = w.sum(axis=(0, 1))
     with np.errstate(invalid="ignore", divide="ignore"):
         per_band = np.where(swb > 0, (w * dz ** 2).sum(axis=(0, 1)) / swb, np.nan)
+        pb_floor = np.where(swb > 0, (w > 0).sum(axis=(0, 1)) / swb, np.nan)
     n = int((w > 0).sum())
-    return Gap(float((w * dz ** 2).sum() / sw), per_band, float(n / sw), n, ref.bands,
+    return Gap(float((w * dz ** 2).sum() / sw), per_band, float(n / sw), pb_floor, n, ref.bands,
                np.where(w > 0, d, np.nan), w)

@@ -104,6 +104,7 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
         s["ranking"] = R.records()
         s["nominal"] = {"heldout_gap": float(np.mean(R.before)), "heldout_gap_per_seed": R.before,
                         "per_band": R.per_band_before, "noise_floor": R.floor,
+                        "per_band_noise_floor": R.per_band_floor,
                         "null_gap_mean": R.null.mean, "null_gap_std": R.null.std,
                         "null_gaps": R.null.gaps, "gap_present": R.gap_present,
                         "bands_hz": [[float(b[0]), float(b[2])] for b in R.bands],
@@ -152,8 +153,7 @@ def _vlim(summary):
 
 
 def _heat(ax, chans, fc, val, sig, est, vlim):
-    cmap = colormaps["RdBu_r"].copy()
-    cmap.set_bad("0.85")
+    cmap = colormaps["RdBu_r"].with_extremes(bad="0.85")
     im = ax.imshow(np.ma.masked_invalid(val), cmap=cmap, vmin=-vlim, vmax=vlim, aspect="auto",
                    origin="upper", interpolation="nearest")
     ii, jj = np.nonzero(sig)
@@ -275,8 +275,8 @@ def plot_shrink_bands(summary: Mapping, path: str | os.PathLike) -> Path:
     ax = fig.add_subplot()
     ax.plot(fc, b, "o-", color="0.3", ms=3, label="nominal model")
     ax.plot(fc, a, "s-", color="C2", ms=3, label=f"with {H['effect']}")
-    ax.axhline(summary["nominal"]["noise_floor"], color="0.6", ls="--", lw=1,
-               label="noise floor (correct model)")
+    fl = np.array([np.nan if v is None else v for v in summary["nominal"]["per_band_noise_floor"]])
+    ax.plot(fc, fl, "--", color="0.6", lw=1, label="noise floor (expected for a correct model)")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("third-octave band centre [Hz]")
@@ -356,7 +356,8 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
         L.append("**Front-to-rear delay** (GCC-SCOT; measured/simulated ratio with 95 % interval "
                  "over time blocks; apparent speed scale = expected delay wheelbase/speed over "
                  "measured delay):\n")
-        L.append("| front | rear | delay meas [s] | delay sim [s] | expected [s] | meas/sim | apparent speed scale | flagged |")
+        L.append("| front | rear | delay meas [s] | delay sim [s] | expected [s] | meas/sim "
+                 "| apparent speed scale | flagged |")
         L.append("|---|---|---|---|---|---|---|---|")
         for r in FR["delay"]:
             ci = r["delay_ratio_ci95"]
@@ -389,7 +390,8 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                  f"held-out gap {nom['heldout_gap']:.3g}; a correct model would give "
                  f"{nom['null_gap_mean']:.3g} +- {_fmt(nom['null_gap_std'], '{:.2g}')} "
                  f"(nominal vs nominal). Accepted: improvement beyond 2 sd of that noise and lower BIC.\n")
-        L.append("| rank | effect | parameters | gap before | gap after | shrink | spread | dBIC | accepted |")
+        L.append("| rank | effect | parameters | gap before | gap after | shrink | spread | dBIC "
+                 "| accepted |")
         L.append("|---|---|---|---|---|---|---|---|---|")
         for i, r in enumerate(summary["ranking"], 1):
             par = "; ".join(f"{e}: " + ", ".join(f"{k}={v:.4g}" if isinstance(v, (int, float)) else f"{k}={v}"

@@ -277,10 +277,10 @@ def simulate(state: ToyState, window, seed: int) -> Signals:
 def _frf2(state: ToyState, f: np.ndarray) -> np.ndarray:
     """|H|^2 from road height to (susp, axle, body) at f (Hz), sensor included; (3, nf)."""
     A, B, C, D = _ss(state.car)
-    s = 2j * np.pi * f
-    H = np.empty((3, f.size), dtype=complex)
-    for k, sk in enumerate(s):
-        H[:, k] = (C @ np.linalg.solve(sk * np.eye(4) - A, B) + D)[:, 0]
+    s = 2j * np.pi * np.asarray(f, dtype=float)
+    M = s[:, None, None] * np.eye(4)[None] - A[None]
+    X = np.linalg.solve(M, np.broadcast_to(B, (s.size, 4, 1)))          # (nf, 4, 1)
+    H = (np.einsum("oi,fi->of", C, X[:, :, 0]) + D)                     # (3, nf)
     g = np.abs(H) ** 2
     if state.sensor_cutoff_hz is not None:
         bb, aa = signal.butter(2, state.sensor_cutoff_hz, fs=200.0)

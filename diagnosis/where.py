@@ -23,7 +23,9 @@ where its interval excludes zero.  Marginal 95 % intervals are kept as
 ``min_nu`` (default 6); short segments make the lowest bands non-estimable.
 
 Segments are time windows in s from the first sample of each record; simulated and
-measured records are assumed to cover the same drive (same speed profile).
+measured records are assumed to cover the same drive (same speed profile).  Both sides
+of a cell use the same Welch segment lengths (chosen on the measured side) where the
+sample rates agree.
 
 What it is not: proof that the model is wrong where flagged; a road misfit shows up
 here as well (broadband, often all channels alike).  ``diagnosis.compare`` gives the
@@ -199,6 +201,10 @@ def _spectra(sig: Signals, names, t0, t1, bands, **kw) -> BandSpectrum:
     return band_powers(x, w.fs, bands, **kw)
 
 
+def _same_rate(a: Signals, b: Signals) -> bool:
+    return abs(a.fs - b.fs) <= 1e-6 * a.fs
+
+
 def localize(measured, simulated, *, segments: Sequence[Segment | tuple] | None = None,
              channels: Sequence[str] | None = None, bands: np.ndarray | None = None,
              q: float = 0.05, whole: bool = True, min_nu: float = 6.0,
@@ -244,7 +250,9 @@ def localize(measured, simulated, *, segments: Sequence[Segment | tuple] | None 
     num = np.zeros(shape)
     for i, (_, t0, t1) in enumerate(rows):
         bm = _spectra(meas, names, t0, t1, bands, **kw)
-        bs = _spectra(sim, names, t0, t1, bands, **kw)
+        # the same Welch segment lengths on both sides (same leakage), where the rates agree
+        bs = _spectra(sim, names, t0, t1, bands, nperseg=bm.nperseg, **kw) if _same_rate(meas, sim) \
+            else _spectra(sim, names, t0, t1, bands, **kw)
         with np.errstate(divide="ignore", invalid="ignore"):
             d[i] = np.log(bs.power / bm.power)
         nus[i], num[i] = bs.nu, bm.nu

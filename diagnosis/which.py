@@ -152,7 +152,8 @@ def candidates_from_library(library: Mapping[str, Any], names: Sequence[str] | N
     Each effect is read duck-typed: ``.parameters`` is a sequence of objects or dicts
     with ``name``, ``default`` and ``range`` (lo, hi); an optional attribute
     ``diagnosis_parameters`` (names) picks which ones are calibrated, else the first
-    ``max_free`` with a range.  Log search where ``lo > 0`` and ``hi / lo >= 10``.
+    ``max_free`` with a range, the effect's ``primary`` parameter (the one
+    ``NAME=VALUE`` sets) first.  Use ``max_free=1`` for the cheapest search.  Log search where ``lo > 0`` and ``hi / lo >= 10``.
 
     Parameters
     ----------
@@ -175,6 +176,8 @@ def candidates_from_library(library: Mapping[str, Any], names: Sequence[str] | N
             raise EroadInputError(f"unknown effect {name!r}; known: {', '.join(library)}")
         eff = library[name]
         params = list(get(eff, "parameters", []) or [])
+        primary = get(eff, "primary", "") or ""
+        params.sort(key=lambda p: get(p, "name") != primary)      # the primary parameter first
         chosen = list(get(eff, "diagnosis_parameters", []) or [])
         free, fixed = [], {}
         for p in params:
@@ -418,6 +421,7 @@ class Ranking:
     before : (S,) array   held-out gap of the nominal model per seed
     per_band_before : (nb,) array
     floor : float         expected gap of a correct model (sampling noise)
+    per_band_floor : (nb,) array
     null : NullReference
     gap_present : bool    nominal gap beyond noise
     verdict : str         accepted effect (``"a+b"`` for a pair) or ``"none"``
@@ -431,6 +435,7 @@ class Ranking:
     before: np.ndarray
     per_band_before: np.ndarray
     floor: float
+    per_band_floor: np.ndarray
     null: NullReference
     gap_present: bool
     verdict: str
@@ -553,13 +558,13 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
 
     say("nominal model on held-out data")
     state0 = fit({}, sc.heldout)
-    g0 = [band_gap(sc.sims(state0, sc.heldout, 1, i), sc.ref_held) for i in range(n_seeds)]
+    nominal_sims = [sc.sims(state0, sc.heldout, 1, i) for i in range(max(n_seeds, n_null))]
+    g0 = [band_gap(nominal_sims[i], sc.ref_held) for i in range(n_seeds)]
     before = np.array([g.value for g in g0])
     null = []
     for i in range(n_null):
         surrogate = reference(sc.sims(state0, sc.heldout, 2, i), sc.ref_held.channels, sc.ref_held.bands)
-        sims = sc.sims(state0, sc.heldout, 1, i)
-        null.append(band_gap(sims, surrogate).value)
+        null.append(band_gap(nominal_sims[i], surrogate).value)
     null = NullReference(np.array(null))
     sd0 = null.std
     gap_present = bool(before.mean() > null.mean + z * sd0)
@@ -628,7 +633,7 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     settings = dict(seed=seed, n_seeds=n_seeds, n_calib_seeds=n_calib_seeds, n_null=n_null, z=z,
                     grid=grid, refine=refine, pairs=pairs, channels=sc.ref_held.channels,
                     n_calib_windows=len(sc.calib), n_heldout_windows=len(sc.heldout))
-    return Ranking(entries, before, pb_before, floor, null,
+    return Ranking(entries, before, pb_before, floor, _nanmean([g.per_band_floor for g in g0]), null,
                    gap_present, verdict, conf, reason, sc.ref_held.bands, settings)
 
 

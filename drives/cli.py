@@ -143,7 +143,7 @@ def cmd_synth(args) -> int:
         print(json.dumps(summary, indent=2))
     else:
         print(f"wrote {summary['out']}: {summary['duration_s']:g} s at "
-              f"{summary['sample_rate_hz']:g} Hz, {len(summary['channels'])} channels, "
+              f"{summary['sample_rate_hz']:g} Hz, {len(summary['channels']) - 1} channels + speed, "
               f"{len(summary['segments'])} road segments, seed {summary['seed']} "
               f"({summary['wall_s']:.1f} s wall)")
     return 0

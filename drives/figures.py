@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import welch
 
-from drives.format import Drive, read_drive
+from drives.format import Drive, read_drive, temp_folder_beside
 from eroad.errors import EroadInputError
 
 #: Welch segment length [s]: 0.2 Hz resolution, enough averages in a 10 s window
@@ -164,7 +164,7 @@ def figures_command(dataset, out, *, window=None, channel="susp_disp_3L", force=
         raise EroadInputError(f"{out}: exists and is not empty; choose another --out or use --force")
     drive = read_drive(dataset)
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
+    tmp = temp_folder_beside(out)
     try:
         summary = plot_figures(drive, tmp, window=window, channel=channel)
         (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

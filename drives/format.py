@@ -777,6 +777,33 @@ def read_drive(path) -> Drive:
 
 # --------------------------------------------------------------------------- writing
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def temp_folder_beside(target) -> Path:
+    """A new temporary folder in the parent of ``target`` (for write-then-rename).
+
+    Unlike :func:`tempfile.mkdtemp` (mode 0700) it gets the ordinary permissions
+    of a new folder (0777 less the umask), which it keeps after the rename.
+
+    Parameters
+    ----------
+    target : str or Path
+        The folder that will be replaced by the temporary one.
+
+    Returns
+    -------
+    Path
+    """
+    target = Path(target)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=target.parent))
+    os.chmod(tmp, 0o777 & ~_umask())
+    return tmp
+
+
 def _toml_dumps(doc: dict) -> str:
     import tomli_w
 
@@ -840,7 +867,7 @@ def write_drive(folder, frame: pd.DataFrame, meta: dict, *, vehicle_file=None,
         meta["sample_rate_hz"] = float((t.size - 1) / (t[-1] - t[0]))
     if vehicle_file is not None:
         meta.setdefault("vehicle", VEHICLE_FILE)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.tmp-", dir=parent))
+    tmp = temp_folder_beside(folder)
     try:
         frame.to_csv(tmp / CHANNELS_FILE, index=False, lineterminator="\n", na_rep="nan")
         doc = {"dataset": meta}

@@ -34,6 +34,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import os
 import shutil
 import time
 import tomllib
@@ -44,7 +45,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import PchipInterpolator
 
-from drives.format import TRUTH_DIR, read_drive, write_drive
+from drives.format import TRUTH_DIR, _umask, read_drive, write_drive
 from eroad.errors import EroadInputError
 
 #: folder of the built-in scenario files
@@ -323,6 +324,10 @@ def resolve_scenario(cfg: dict, seed: int | None = None, *, effects=(), vehicle=
             merged = dict(eff.get(name, {}))
             merged.update(params or {})
             eff[name] = merged
+    if eff:
+        from vehicles.effects import resolve_effects
+
+        eff = {name: dict(params) for name, params in resolve_effects(eff).items()}
     tr["effects"] = eff
     noise = cfg["noise"]
     for key in _KEYS["noise"]:
@@ -382,13 +387,14 @@ def plan_drive(cfg: dict, axle_x: list[float]) -> dict:
     t_bounds = T * np.concatenate([[0.0], np.cumsum(props)])
     t_bounds[-1] = T
     x_bounds = np.interp(t_bounds, t_rec, x_ref)
-    road_length = float(x_front0 + s[-1] + ROAD_MARGIN_M)
+    dx = float(cfg["road"]["dx_m"])
+    road_length = float(math.ceil((x_front0 + s[-1] + ROAD_MARGIN_M) / dx) * dx)
     edges = np.concatenate([[0.0], x_bounds[1:-1], [road_length]])
     seg_out = []
     for i, seg in enumerate(cfg["road"]["segments"]):
         seg_out.append(dict(seg, t_start=float(t_bounds[i]), t_end=float(t_bounds[i + 1]),
                             x_start=float(edges[i]), x_end=float(edges[i + 1])))
-    return {"t_sim": t_rec + runin, "t_rec": t_rec, "v_sim": v, "n_runin": n_run,
+    return {"t_sim": t_rec + runin, "t_rec": t_rec, "v_sim": v, "x_ref": x_ref, "n_runin": n_run,
             "n_record": n_rec, "x_front0": float(x_front0), "road_length": road_length,
             "seg_lengths": list(np.diff(edges)), "segments": seg_out}
 
@@ -474,7 +480,8 @@ def _jsonable(obj):
 
 
 #: SimResult.meta keys that vary from run to run and stay out of truth/
-_VOLATILE = {"wall_s", "realtime_factor", "wall_time_s", "started", "finished", "host"}
+_VOLATILE = {"wall_s", "solve_s", "realtime_factor", "wall_time_s", "started", "finished",
+             "host"}
 
 
 def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
@@ -532,11 +539,18 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
     clean["speed"] = plan["v_sim"][n_run:n_run + n_rec]
     noisy = add_noise(clean, cfg["noise"], seed)
 
+    # the road puts each junction half-way between grid samples: the actual boundaries
+    # (within dx/2 of the planned ones) and the reference axle's times at them
+    actual = road.meta["segments"]
     segments = []
-    for s in plan["segments"]:
+    for i, s in enumerate(plan["segments"]):
         d = dict(s)
-        d["t_start"] += start
-        d["t_end"] += start
+        d["x_start"] = 0.0 if i == 0 else float(actual[i]["start"])
+        d["x_end"] = float(road.x_max) if i == len(actual) - 1 else float(actual[i]["end"])
+        d["t_start"] = start + (0.0 if i == 0 else float(np.interp(d["x_start"], plan["x_ref"],
+                                                                     plan["t_rec"])))
+        d["t_end"] = start + (n_rec / fs if i == len(actual) - 1 else
+                              float(np.interp(d["x_end"], plan["x_ref"], plan["t_rec"])))
         d["duration_s"] = d["t_end"] - d["t_start"]
         d["dx_m"] = float(cfg["road"]["dx_m"])
         d["dy_m"] = float(cfg["road"]["dy_m"])
@@ -567,7 +581,7 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
     }
     truth = _jsonable(truth)
     summary = {
-        "out": str(out), "scenario": sc["name"], "seed": seed, "dataset_name": sc["dataset_name"],
+        "scenario": sc["name"], "seed": seed, "dataset_name": sc["dataset_name"],
         "duration_s": n_rec / fs, "sample_rate_hz": fs, "channels": list(noisy.columns[1:]),
         "speed_range_mps": [truth["speed"]["min_mps"], truth["speed"]["max_mps"]],
         "segments": [{k: s[k] for k in ("t_start", "t_end", "proportion", "Gq_n0", "w", "nmin",
@@ -585,6 +599,9 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
         (td / "summary.json").write_text(json.dumps(_jsonable(summary), indent=1) + "\n")
         clean.to_csv(td / "channels_clean.csv", index=False, lineterminator="\n")
         road.save(td / "road.npz")
+        mode = 0o666 & ~_umask()
+        for f in td.iterdir():
+            os.chmod(f, mode)
 
     meta = {"name": sc["dataset_name"], "sample_rate_hz": fs, "start_time_s": start,
             "description": "virtual test drive (eroad synth); what made it is in truth/"}
@@ -595,6 +612,7 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
     else:
         meta["vehicle"] = str(sc["vehicle"])
     write_drive(out, noisy, meta, vehicle_file=vfile, overwrite=force, add_files=add_truth)
+    summary["out"] = str(out)
     summary["wall_s"] = time.perf_counter() - t_wall
     return _jsonable(summary)
 
@@ -683,8 +701,6 @@ def default_dataset(path=None) -> Path:
     Path
         The dataset folder.
     """
-    import os
-
     if path is None:
         root = Path(os.environ.get("EROAD_CACHE", DEFAULT_CACHE))
         path = root / "datasets" / f"{DEFAULT_SCENARIO}-seed{DEFAULT_SEED}"

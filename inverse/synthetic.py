@@ -15,6 +15,7 @@ Run ``python -m inverse.synthetic --cases 20`` for the accuracy table.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import time as _time
@@ -28,8 +29,8 @@ from inverse.pipeline import SEED_KEY_FIT, InversionConfig, invert, segment_erro
 from inverse.quarter import (QuarterTruck, QuarterTruckParams, QuarterTruckSimulator, add_sensor_noise,
                              travelled_distance)
 from inverse.segmentation import band_pass, classify
-from inverse.sensitivity import FitConfig, fit_segments
-from inverse.spectral import ISO_CLASS_GD0, ParamBounds, iso_class
+from inverse.sensitivity import fit_segments
+from inverse.spectral import ISO_CLASS_GD0, iso_class
 
 #: default white sensor noise per quantity [m, m/s^2, m/s^2]
 DEFAULT_NOISE = {"susp_disp": 2e-4, "axle_acc": 0.05, "body_acc": 0.02}
@@ -186,7 +187,8 @@ def quarter_predict_rms(vehicle: QuarterTruckParams = QuarterTruckParams(), band
 
 
 def recovery_study(n_cases: int = 20, seed: int = 0, replicates: int = 1, oracle: bool = False,
-                   known_noise: bool = False, min_len: float = 3.0, verbose: bool = False) -> dict:
+                   known_noise: bool = False, min_len: float = 3.0, verbose: bool = False,
+                   config: InversionConfig = InversionConfig(), spec_kwargs=None) -> dict:
     """Blind recovery of random scenarios on the quarter truck.
 
     Parameters
@@ -204,6 +206,10 @@ def recovery_study(n_cases: int = 20, seed: int = 0, replicates: int = 1, oracle
         Shortest true segment [s].
     verbose : bool
         Print one line per case.
+    config : InversionConfig
+        Fit settings (its k, feature_spec and seed are set per case).
+    spec_kwargs : dict, optional
+        Extra :class:`FeatureSpec` settings.
 
     Returns
     -------
@@ -214,13 +220,12 @@ def recovery_study(n_cases: int = 20, seed: int = 0, replicates: int = 1, oracle
     """
     rows = {"ln_Gq_err": [], "w_err": [], "class_ok": [], "duration": [], "boundary_err": [],
             "wall_s": [], "n_sims": [], "k_true": [], "k_found": [], "nmin_identifiable": [],
-            "nmax_identifiable": []}
+            "nmax_identifiable": [], "truth": [], "fitted": []}
     for i in range(n_cases):
         P, dur, speed = random_scenario(seed + i, min_len=min_len)
         drive = make_drive(P, dur, speed=speed, seed=seed + i)
-        spec = FeatureSpec(channels=tuple(sorted(drive.channels)), replicates=replicates)
-        cfg = InversionConfig(k=P.shape[0] if oracle else None, feature_spec=spec, seed=seed + i,
-                              fit=FitConfig())
+        spec = FeatureSpec(channels=tuple(sorted(drive.channels)), replicates=replicates, **(spec_kwargs or {}))
+        cfg = dataclasses.replace(config, k=P.shape[0] if oracle else config.k, feature_spec=spec, seed=seed + i)
         make = quarter_simulator_factory(drive.time, drive.speed, drive.vehicle)
         t0 = _time.perf_counter()
         if oracle:
@@ -233,9 +238,9 @@ def recovery_study(n_cases: int = 20, seed: int = 0, replicates: int = 1, oracle
                 sel = (drive.time >= drive.t_bounds[k]) & (drive.time < drive.t_bounds[k + 1])
                 r = math.sqrt(np.mean([np.mean(band_pass(drive.channels[c], drive.fs, 0.2, 20.0)[sel] ** 2)
                                        for c in ("susp_disp_3L", "susp_disp_3R")]))
-                p0[k] = (classify(r, float(np.mean(drive.speed[sel])), pr)[0], 2.0, 0.05, 5.0)
+                p0[k] = (classify(r, float(np.mean(drive.speed[sel])), pr, cfg.w0)[0], cfg.w0, cfg.nmin0, cfg.nmax0)
             fit = fit_segments(make(drive.t_bounds), feats, p0, seed=stream_seed(seed + i, SEED_KEY_FIT),
-                               bounds=ParamBounds().for_record(drive.fs, drive.speed.max()))
+                               bounds=cfg.bounds.for_record(drive.fs, drive.speed.max()), config=cfg.fit)
             found_tb, fitted, idents = drive.t_bounds, fit.params, [s.identifiable for s in fit.segments]
             n_sims = fit.n_sims
         else:
@@ -258,6 +263,8 @@ def recovery_study(n_cases: int = 20, seed: int = 0, replicates: int = 1, oracle
             rows["w_err"].append(float(fitted[j, 1] - P[k, 1]))
             rows["class_ok"].append(iso_class(fitted[j, 0]) == iso_class(P[k, 0]))
             rows["duration"].append(float(b - a))
+            rows["truth"].append(P[k].tolist())
+            rows["fitted"].append(fitted[j].tolist())
             rows["nmin_identifiable"].append(bool(idents[j]["nmin"]))
             rows["nmax_identifiable"].append(bool(idents[j]["nmax"]))
         if verbose:

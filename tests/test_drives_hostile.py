@@ -242,3 +242,16 @@ def test_missing_folder_and_file_instead_of_folder(tmp_path):
     f.write_text("time\n")
     assert "not a folder" in check_drive(f)[0]
     assert not os.path.exists(tmp_path / "nope")
+
+
+def test_crlf_bom_and_spaces_are_accepted(tmp_path):
+    """Files from Windows tools (BOM, CRLF) and 'time, susp_disp_3L' spacing read the same."""
+    ref = read_drive(make(tmp_path, L, name="ref"))
+    d = tmp_path / "win"
+    d.mkdir()
+    text = "\r\n".join(ln.replace(",", ", ") for ln in L) + "\r\n"
+    (d / "channels.csv").write_bytes(b"\xef\xbb\xbf" + text.encode())
+    (d / "meta.toml").write_text(META)
+    win = read_drive(d)
+    np.testing.assert_array_equal(win.time, ref.time)
+    pd.testing.assert_frame_equal(win.channels, ref.channels)

@@ -22,17 +22,32 @@ road; the vehicle does not move along x: the road moves under it):
 * suspension: per axle side one Cartesian spring-damper between the spring seat on
   the frame and on the axle, vertical spring and damper of the suspension, stiff
   longitudinal and lateral guide;
+* axle wind-up: a rotational spring about y between axle and frame (leaf-spring
+  bending or torque rods);
 * tyres: per tyre (two for a dual pair at +-dual_spacing/2) one Cartesian
-  spring-damper from the contact point on the axle to the ground: vertical tyre
-  stiffness and damping, lateral and longitudinal tyre stiffness.  The road enters
+  spring-damper from the wheel centre to the ground: vertical tyre stiffness and
+  damping, lateral tyre stiffness (no longitudinal stiffness: the wheels roll).  The element sits at the wheel
+  centre because the contact of a rolling wheel stays below the wheel centre
+  whatever the wheel's spin; a body-fixed contact point would let the preloaded
+  vertical tyre force destabilise the axle's pitch (the lever arm of the lateral
+  tyre force, tyre radius x lateral force, is neglected).  The road enters
   as a force: a tyre force ``k (z_r - u) + c (dz_r/dt - du/dt)`` is the constant
   spring-damper ``-k u - c du/dt`` plus the known force ``k z_r + c dz_r/dt``; the
-  road forces of all tyres of an axle are applied as one vertical force at the
-  axle's contact line plus one roll moment (two loads per axle, set once per
-  step).  This is exact for the linear (bilateral) tyre; tyre lift-off is not
-  modelled (:attr:`SimResult.meta` reports when a tyre would have lifted);
+  road forces of all tyres of an axle are one vertical force at the wheel-centre
+  line plus one roll moment (``road_loads``, two loads per axle).  In the time
+  simulation the same generalised forces are applied through one
+  ``ObjectGenericODE2`` over all axle nodes (``injector``, mapping
+  :meth:`VehicleModel.road_input_matrix` at static equilibrium), set with a single
+  call per step.  This is exact for the linear (bilateral) tyre up to the
+  rotation of the axles from static (the force directions are frozen at
+  equilibrium; axle rotations are ~1e-3 rad); tyre lift-off is not modelled
+  (``SimResult.meta`` reports when a tyre would have lifted);
 * DCDC block (tractor): a rigid body on a 6-DOF mount spring-damper equivalent to
   four mounts at the corners of its base;
+* surge: wheels roll freely, so nothing ties the vehicle to the road along x but
+  its speed control; a longitudinal spring-damper (3 Hz, damping ratio 0.5, whole
+  vehicle mass) from the moving reference to the chassis at its centre of gravity
+  stands for it (at the centre of gravity it does not couple with pitch);
 * gravity on every body; static equilibrium on a flat road by Exudyn's static
   solver, which is the reference (zero) of every output.
 
@@ -56,6 +71,9 @@ from vehicles.params import VehicleParams
 GRAVITY = 9.81
 #: damping of the stiff axle guides, as a time constant times their stiffness [s]
 GUIDE_DAMPING_TIME = 2e-3
+#: frequency [Hz] and damping ratio [-] of the vehicle's surge on its speed control
+SURGE_HZ = 3.0
+SURGE_DAMPING = 0.5
 SIDES = ("L", "R")
 SIDE_SIGN = {"L": 1.0, "R": -1.0}
 #: node outputs recorded for every body (world frame)
@@ -111,7 +129,8 @@ class Contact:
         Lateral position in vehicle coordinates [m] (road lateral position is
         ``y_offset + y``).
     local : ndarray (3,)
-        Contact point in axle body coordinates (relative to the axle cog) [m].
+        Tyre attachment point (wheel centre) in axle body coordinates, relative to
+        the axle's centre of gravity [m].
     stiffness, damping : float
         Vertical tyre stiffness [N/m] and damping [N s/m].
     obj : int
@@ -174,7 +193,8 @@ class VehicleModel:
     contacts : list of Contact
     suspensions : list of Suspension
     joints : list of int
-        Exudyn objects of the frame joints (``FrameJoint`` data in ``frame_joints``).
+        Exudyn objects of the frame joints (``FrameJoint`` data in ``frame_joints``),
+        the axle wind-up springs and the DCDC mount.
     road_loads : list of (int, int)
         Per axle: (vertical force load, roll torque load) carrying the road input.
     sensors : dict
@@ -201,6 +221,8 @@ class VehicleModel:
     sensors: dict = field(default_factory=dict)
     static: dict = field(default_factory=dict)
     ground: int = -1
+    surge: int = -1
+    injector: int = -1
     _keep: list = field(default_factory=list)   # symbolic user functions must stay alive
 
     # ------------------------------------------------------------------ geometry
@@ -290,8 +312,63 @@ class VehicleModel:
         return out
 
     # ------------------------------------------------------------------ road input
+    def road_input_matrix(self) -> np.ndarray:
+        """Generalised forces of unit road forces, at the current (static) state.
+
+        A road force ``f_c = k_c z_r + c_c dz_r/dt`` [N] (upwards) at the wheel centre of
+        tyre ``c`` acts on the axle node's coordinates as ``Q = B[:, c] f_c``:
+        translation ``e_z``, rotation ``G^T (d x e_z)`` with ``d`` the lateral offset of
+        the wheel from the axle centre and ``G`` the node's angular-velocity matrix
+        (omega = G dq/dt).
+
+        Returns
+        -------
+        ndarray (n_inj, n_contacts)
+            Rows ordered like the injector's ``forceVector``: the coordinates of the
+            axle nodes, axle by axle (7 per EP node, 6 per Rxyz node).  Global ODE2
+            rows: ``coordinate_indices()[axle name]``.
+        """
+        from exudyn import rigidBodyUtilities as rbu
+
+        exu = _exu()
+        nq = 7 if self.node_type == "EP" else 6
+        B = np.zeros((nq * len(self.axles), len(self.contacts)))
+        G = []
+        for b in self.axles:
+            q = np.asarray(self.mbs.GetNodeOutput(b.node, exu.OutputVariableType.Coordinates)) + \
+                np.asarray(self.mbs.GetNode(b.node)["referenceCoordinates"])
+            G.append(rbu.EulerParameters2G(q[3:7]) if self.node_type == "EP" else rbu.RotXYZ2G(q[3:6]))
+        for c, ct in enumerate(self.contacts):
+            a = ct.axle
+            R = np.asarray(self.mbs.GetNodeOutput(self.axles[a].node,
+                                                  exu.OutputVariableType.RotationMatrix)).reshape(3, 3)
+            d = R @ ct.local
+            ez = np.array([0.0, 0.0, 1.0])
+            B[a * nq + 2, c] = 1.0
+            B[a * nq + 3:(a + 1) * nq, c] = G[a].T @ np.cross(d, ez)
+        return B
+
+    def road_input_matrix_global(self) -> np.ndarray:
+        """:meth:`road_input_matrix` scattered to the global ODE2 coordinates (n, nc)."""
+        B = self.road_input_matrix()
+        idx = self.coordinate_indices()
+        n = sum(len(v) for v in idx.values())
+        Bg = np.zeros((n, B.shape[1]))
+        nq = 7 if self.node_type == "EP" else 6
+        for a, b in enumerate(self.axles):
+            Bg[idx[b.name]] = B[a * nq:(a + 1) * nq]
+        return Bg
+
+    def set_injector(self, q) -> None:
+        """Set the road generalised forces (``road_input_matrix() @ f_contacts``)."""
+        self.mbs.SetObjectParameter(self.injector, "forceVector", np.asarray(q, float))
+
     def set_road_forces(self, force: np.ndarray, torque: np.ndarray) -> None:
-        """Set the road forces of all axles (one call per load).
+        """Set the road forces of all axles through the road loads (one call per load).
+
+        The loads define the road input exactly (vertical force at the wheel-centre
+        line, roll moment); :func:`vehicles.simulate.simulate` leaves them at zero and
+        applies the same generalised forces through the injector.
 
         Parameters
         ----------
@@ -310,7 +387,8 @@ class VehicleModel:
         -------
         (Bf, Bt) : ndarrays (n_axles, n_contacts)
             ``force = Bf @ (k z_r + c dz_r/dt)`` per contact, likewise the torque;
-            i.e. ``Bf[a, c] = 1`` if contact c is on axle a, ``Bt[a, c] = y_c``.
+            i.e. ``Bf[a, c] = 1`` if contact c is on axle a, ``Bt[a, c] = y_c`` (the
+            lateral position of the tyre relative to the axle centre).
         """
         na, nc = len(self.axles), len(self.contacts)
         Bf, Bt = np.zeros((na, nc)), np.zeros((na, nc))
@@ -370,7 +448,8 @@ class VehicleModel:
         """Static vertical tyre forces [N] (positive = pressing on the road), per contact."""
         out = []
         for ct in self.contacts:
-            z = self.point_position(self.axles[ct.axle].name, ct.local)[2]
+            ab = self.axles[ct.axle]
+            z = self.point_position(ab.name, ct.local)[2] - (ab.cog[2] + ct.local[2])
             out.append(-ct.stiffness * z)
         return np.array(out)
 
@@ -390,6 +469,33 @@ def _quiet():
 
 def _rot_coords(node_type):
     return [1.0, 0.0, 0.0, 0.0] if node_type == "EP" else [0.0, 0.0, 0.0]
+
+
+def equivalent_6x6(points, k3) -> np.ndarray:
+    """6x6 stiffness (or damping) of parallel point springs, for small motions.
+
+    Springs with diagonal stiffness ``k3[i]`` (x, y, z, global axes) at positions
+    ``points[i]`` relative to a reference point act on the relative displacement
+    ``u`` and small rotation ``theta`` of two bodies as one 6-DOF spring:
+    ``K = sum T_i^T diag(k_i) T_i`` with ``T_i = [I, -[r_i]x]`` (the point moves by
+    ``u + theta x r_i``).  Exact for the linearised system.
+
+    Parameters
+    ----------
+    points : sequence of (3,) [m]
+    k3 : sequence of (3,) [N/m] (or [N s/m])
+
+    Returns
+    -------
+    ndarray (6, 6) [N/m, N/rad, N m/rad]
+    """
+    K = np.zeros((6, 6))
+    for r, k in zip(points, k3):
+        r = np.asarray(r, float)
+        rx = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+        T = np.hstack([np.eye(3), -rx])
+        K += T.T @ np.diag(np.asarray(k, float)) @ T
+    return K
 
 
 def build_model(vp: VehicleParams, chassis: str = "rigid", frame_segments: int | None = None,
@@ -477,6 +583,19 @@ def build_model(vp: VehicleParams, chassis: str = "rigid", frame_segments: int |
             model.joints.append(mbs.AddObject(ii.ObjectConnectorRigidBodySpringDamper(
                 markerNumbers=[m0, m1], stiffness=np.diag(j.stiffness), damping=np.diag(j.damping))))
 
+    # ---- surge: the vehicle follows the prescribed speed; a longitudinal spring from
+    # the moving reference to the chassis at its centre of gravity (no pitch coupling)
+    # holds the otherwise free rolling motion (wheel spin is not modelled)
+    total = combine([(s.mass, s.cog, s.inertia) for s in segs])
+    surge_seg = model.segments[segment_index(bounds, float(total[1][0])) if chassis == "flexible" else 0]
+    m_veh = vp.total_mass
+    k_surge = m_veh * (2 * np.pi * SURGE_HZ) ** 2
+    mg0 = mbs.AddMarker(ii.MarkerBodyPosition(bodyNumber=model.ground,
+                                              localPosition=list(surge_seg.cog)))
+    model.surge = mbs.AddObject(ii.ObjectConnectorCartesianSpringDamper(
+        markerNumbers=[mg0, pos_marker(surge_seg, surge_seg.cog)], stiffness=[k_surge, 0.0, 0.0],
+        damping=[2 * SURGE_DAMPING * np.sqrt(k_surge * m_veh), 0.0, 0.0]))
+
     # ---- axles, suspension, tyres, road loads
     gm = {}
 
@@ -487,6 +606,7 @@ def build_model(vp: VehicleParams, chassis: str = "rigid", frame_segments: int |
                                                           localPosition=list(point)))
         return gm[key]
 
+    per_side = suspension_terms is not None
     for a, ax in enumerate(vp.axles):
         r = ax.tyre_radius
         ya = ax.track / 2
@@ -495,15 +615,24 @@ def build_model(vp: VehicleParams, chassis: str = "rigid", frame_segments: int |
         model.axles.append(body)
         seg_i = segment_index(bounds, ax.x) if chassis == "flexible" else 0
         seg = model.segments[seg_i]
+        centre = np.array([ax.x, 0.0, r])
+        seat_c = np.array([ax.x, 0.0, ax.seat_height])
+        k_susp, c_susp, pts_susp = [], [], []
+        k_tyre, c_tyre, pts_tyre = [], [], []
+        first_contact = len(model.contacts)
         for side in SIDES:
             sg = SIDE_SIGN[side]
             point = np.array([ax.x, sg * ax.spring_track / 2, ax.seat_height])
-            k_guide = (ax.guide_longitudinal_stiffness, ax.guide_lateral_stiffness)
             stiff = [ax.guide_longitudinal_stiffness, ax.guide_lateral_stiffness, ax.spring_stiffness]
-            damp = [GUIDE_DAMPING_TIME * k_guide[0], GUIDE_DAMPING_TIME * k_guide[1], ax.damping]
-            m0, m1 = pos_marker(seg, point), pos_marker(body, point)
-            obj = mbs.AddObject(ii.ObjectConnectorCartesianSpringDamper(
-                markerNumbers=[m0, m1], stiffness=stiff, damping=damp))
+            damp = [GUIDE_DAMPING_TIME * stiff[0], GUIDE_DAMPING_TIME * stiff[1], ax.damping]
+            obj = -1
+            if per_side:
+                m0, m1 = pos_marker(seg, point), pos_marker(body, point)
+                obj = mbs.AddObject(ii.ObjectConnectorCartesianSpringDamper(
+                    markerNumbers=[m0, m1], stiffness=stiff, damping=damp))
+            k_susp.append(stiff)
+            c_susp.append(damp)
+            pts_susp.append(point - seat_c)
             model.suspensions.append(Suspension(
                 axle=a, side=side, point=point, segment=seg_i, local_frame=point - seg.cog,
                 local_axle=point - body.cog, stiffness=ax.spring_stiffness, damping=ax.damping,
@@ -511,19 +640,48 @@ def build_model(vp: VehicleParams, chassis: str = "rigid", frame_segments: int |
             offsets = [0.0] if ax.tyres_per_side == 1 else [-ax.dual_spacing / 2, ax.dual_spacing / 2]
             for o in offsets:
                 y = sg * ya + o
-                cp = np.array([ax.x, y, 0.0])
-                mg, mw = ground_marker(cp), pos_marker(body, cp)
-                obj = mbs.AddObject(ii.ObjectConnectorCartesianSpringDamper(
-                    markerNumbers=[mg, mw],
-                    stiffness=[ax.tyre_longitudinal_stiffness, ax.tyre_lateral_stiffness, ax.tyre_stiffness],
-                    damping=[ax.tyre_damping, ax.tyre_damping, ax.tyre_damping]))
+                cp = np.array([ax.x, y, r])   # wheel centre: a rolling wheel's contact stays below it
+                k_tyre.append([0.0, ax.tyre_lateral_stiffness, ax.tyre_stiffness])
+                c_tyre.append([0.0, ax.tyre_damping, ax.tyre_damping])
+                pts_tyre.append(cp - centre)
                 model.contacts.append(Contact(a, side, y, cp - body.cog, ax.tyre_stiffness,
-                                              ax.tyre_damping, obj))
-        # road input: vertical force at the contact line and roll moment (global)
-        mline = pos_marker(body, [ax.x, 0.0, 0.0])
+                                              ax.tyre_damping))
+        # all tyres of the axle: one 6-DOF spring-damper to the ground at the axle centre
+        Kt, Ct = equivalent_6x6(pts_tyre, k_tyre), equivalent_6x6(pts_tyre, c_tyre)
+        obj = mbs.AddObject(ii.ObjectConnectorRigidBodySpringDamper(
+            markerNumbers=[mbs.AddMarker(ii.MarkerBodyRigid(bodyNumber=model.ground,
+                                                            localPosition=list(centre))),
+                           rigid_marker(body, centre)], stiffness=Kt, damping=Ct))
+        for ct in model.contacts[first_contact:]:
+            ct.obj = obj
+        # suspension (both sides, guides) and axle wind-up (pitch relative to the frame:
+        # leaf-spring bending or torque rods): one 6-DOF spring-damper at the seat centre,
+        # or, with extra suspension terms, per-side Cartesian elements plus the wind-up
+        Kw = np.zeros((6, 6))
+        Kw[4, 4] = ax.windup_stiffness
+        if per_side:
+            Ks, Cs = Kw, GUIDE_DAMPING_TIME * Kw
+        else:
+            Ks = equivalent_6x6(pts_susp, k_susp) + Kw
+            Cs = equivalent_6x6(pts_susp, c_susp) + GUIDE_DAMPING_TIME * Kw
+        obj = mbs.AddObject(ii.ObjectConnectorRigidBodySpringDamper(
+            markerNumbers=[rigid_marker(seg, seat_c), rigid_marker(body, seat_c)],
+            stiffness=Ks, damping=Cs))
+        model.joints.append(obj)
+        if not per_side:
+            for su in model.suspensions[-2:]:
+                su.obj = obj
+        # road input: vertical force at the wheel-centre line and roll moment (global)
+        mline = pos_marker(body, [ax.x, 0.0, r])
         lf = mbs.AddLoad(ii.LoadForceVector(markerNumber=mline, loadVector=[0.0, 0.0, 0.0]))
         lt = mbs.AddLoad(ii.LoadTorqueVector(markerNumber=body.marker, loadVector=[0.0, 0.0, 0.0]))
         model.road_loads.append((lf, lt))
+
+    # ---- road input injector: one generalised-force object over all axle nodes, so
+    # that the road forces of a time step are set with one call (see road_input_matrix)
+    model.injector = mbs.AddObject(ii.ObjectGenericODE2(
+        nodeNumbers=[b.node for b in model.axles],
+        forceVector=np.zeros(len(model.axles) * (7 if node_type == "EP" else 6))))
 
     # ---- DCDC block on four mounts (equivalent 6-DOF spring-damper at the base centre)
     d = vp.dcdc

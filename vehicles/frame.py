@@ -269,13 +269,14 @@ def _generalized_eig(M, K):
     return w2[order], V[:, order]
 
 
-def tune_frame(vp: VehicleParams, n_segments: int | None = None, iterations: int = 8,
-               rtol: float = 0.005) -> VehicleParams:
-    """Scale the frame's torsion and bending stiffness to the target frequencies.
+def tune_frame(vp: VehicleParams, n_segments: int | None = None, iterations: int = 24,
+               rtol: float = 0.002) -> VehicleParams:
+    """Set the frame's torsion and bending stiffness so the modes hit their targets.
 
-    Fixed-point iteration GJ <- GJ (f_target / f)^2 (same for EI); the frequency of a
-    frame mode grows with the square root of its stiffness once the frame dominates
-    the mode.
+    Bisection on the logarithm of GJ (torsion) and of EI (bending), alternately, within
+    a factor 30 of the start values (the two modes are nearly uncoupled; a frame
+    mode's frequency grows with its stiffness, and bisection tolerates the jumps of
+    the mode classification where a frame mode crosses an axle-hop mode).
 
     Parameters
     ----------
@@ -283,6 +284,7 @@ def tune_frame(vp: VehicleParams, n_segments: int | None = None, iterations: int
         ``vp.frame.target_torsion_hz`` and ``target_bending_hz`` are the targets.
     n_segments : int, optional
     iterations : int
+        Bisection steps per stiffness.
     rtol : float
         Stop when both frequencies are within this relative error.
 
@@ -292,13 +294,23 @@ def tune_frame(vp: VehicleParams, n_segments: int | None = None, iterations: int
         With tuned ``frame.torsion_stiffness`` and ``frame.bending_stiffness``.
     """
     fr = vp.frame
+    bounds = {"torsion": [np.log(fr.torsion_stiffness / 30), np.log(fr.torsion_stiffness * 30)],
+              "bending": [np.log(fr.bending_stiffness / 30), np.log(fr.bending_stiffness * 30)]}
+    field_of = {"torsion": "torsion_stiffness", "bending": "bending_stiffness"}
+    target = {"torsion": fr.target_torsion_hz, "bending": fr.target_bending_hz}
     for _ in range(iterations):
-        res = frame_mode_frequencies(vp, n_segments)
-        et = fr.target_torsion_hz / res["torsion_hz"]
-        eb = fr.target_bending_hz / res["bending_hz"]
-        if abs(et - 1) < rtol and abs(eb - 1) < rtol:
+        done = True
+        for kind in ("torsion", "bending"):
+            lo, hi = bounds[kind]
+            mid = 0.5 * (lo + hi)
+            vp = replace(vp, frame=replace(vp.frame, **{field_of[kind]: float(np.exp(mid))}))
+            f = frame_mode_frequencies(vp, n_segments)[f"{kind}_hz"]
+            if not np.isfinite(f) or f < target[kind]:
+                bounds[kind][0] = mid
+            else:
+                bounds[kind][1] = mid
+            if not (np.isfinite(f) and abs(f / target[kind] - 1) < rtol):
+                done = False
+        if done:
             break
-        fr = replace(fr, torsion_stiffness=fr.torsion_stiffness * et ** 2,
-                     bending_stiffness=fr.bending_stiffness * eb ** 2)
-        vp = replace(vp, frame=fr)
     return vp

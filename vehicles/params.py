@@ -70,7 +70,6 @@ class Axle:
     tyre_stiffness: float = _f("N/m", "vertical stiffness of one tyre")
     tyre_damping: float = _f("N s/m", "vertical damping of one tyre")
     tyre_lateral_stiffness: float = _f("N/m", "lateral stiffness of one tyre at the contact")
-    tyre_longitudinal_stiffness: float = _f("N/m", "longitudinal stiffness of one tyre at the contact")
     tyre_contact_length: float = _f("m", "length of the contact patch (default of `tyre_enveloping`)")
     spring_type: str = _f("-", "'leaf' or 'air' (leaf springs carry inter-leaf friction)")
     spring_track: float = _f("m", "lateral distance between the left and right spring seats")
@@ -79,6 +78,7 @@ class Axle:
     damping: float = _f("N s/m", "vertical suspension damping per side (mean of compression and rebound)")
     guide_longitudinal_stiffness: float = _f("N/m", "longitudinal stiffness axle-frame per side")
     guide_lateral_stiffness: float = _f("N/m", "lateral stiffness axle-frame per side")
+    windup_stiffness: float = _f("N m/rad", "axle pitch (wind-up) stiffness relative to the frame")
 
 
 @dataclass(frozen=True)
@@ -279,7 +279,7 @@ def validate_vehicle(vp: VehicleParams) -> None:
         w = f"axle[{i}]"
         for name in ("unsprung_mass", "roll_inertia", "pitch_inertia", "yaw_inertia", "track",
                      "tyre_radius", "tyre_stiffness", "tyre_lateral_stiffness",
-                     "tyre_longitudinal_stiffness", "spring_track", "spring_stiffness",
+                     "windup_stiffness", "spring_track", "spring_stiffness",
                      "guide_longitudinal_stiffness", "guide_lateral_stiffness", "seat_height"):
             if not getattr(a, name) > 0:
                 bad(f"{w}.{name}", f"must be positive, got {getattr(a, name)!r}")

@@ -161,6 +161,46 @@ def _speed_profile(speed, duration) -> SpeedProfile:
     return SpeedProfile.constant(v, duration)
 
 
+def road_under_tyres(road, model, x_start, y_offset, s, v):
+    """Road height and its time derivative under every tyre.
+
+    Bilinear interpolation of the surface, done as: the profile of each tyre's track
+    at the road's grid x (interpolated in y), then linear interpolation in x (the
+    same numbers as ``road.height``, and the exact slope of the interpolant).
+
+    Parameters
+    ----------
+    road : RoadSurface
+    model : VehicleModel
+    x_start : float
+        Road x of the first axle at t = 0 [m].
+    y_offset : float
+        Road y of the vehicle centre line [m].
+    s : ndarray (n,)
+        Distance travelled [m].
+    v : ndarray (n,)
+        Speed [m/s].
+
+    Returns
+    -------
+    (z, z_t) : ndarrays (n, n_contacts)
+        Height [m] and its rate [m/s] (slope along x times speed).
+    """
+    vp = model.vp
+    n = s.size
+    z = np.empty((n, len(model.contacts)))
+    z_t = np.empty_like(z)
+    gx = road.x
+    dx = road.dx
+    for c, ct in enumerate(model.contacts):
+        track = road.track(y_offset + ct.y)
+        xq = x_start + vp.axles[ct.axle].x + s
+        z[:, c] = np.interp(xq, gx, track)
+        i = np.clip(((xq - gx[0]) / dx).astype(np.intp), 0, gx.size - 2)
+        z_t[:, c] = (track[i + 1] - track[i]) / dx * v
+    return z, z_t
+
+
 def output_points(model):
     """Body-fixed points behind the output channels.
 
@@ -214,6 +254,31 @@ def _point_kinematics(data, local):
     w, al = data["AngularVelocity"], data["AngularAcceleration"]
     acc = data["Acceleration"] + np.cross(al, d) + np.cross(w, np.cross(w, d))
     return pos, acc
+
+
+def _body_points(data, L):
+    """World positions and accelerations of several body-fixed points.
+
+    Parameters
+    ----------
+    data : dict
+        Node outputs (n samples): Position (n, 3), RotationMatrix (n, 3, 3),
+        Acceleration, AngularVelocity, AngularAcceleration (n, 3), world frame.
+    L : ndarray (m, 3)
+        Points relative to the centre of gravity, body axes [m].
+
+    Returns
+    -------
+    (P, A) : ndarrays (n, 3, m)
+        Positions [m] and accelerations [m/s^2] (a + alpha x d + omega x (omega x d)).
+    """
+    d = np.einsum("nij,mj->nim", data["RotationMatrix"], L)
+    P = data["Position"][:, :, None] + d
+    w = data["AngularVelocity"][:, :, None]
+    al = data["AngularAcceleration"][:, :, None]
+    wd = np.cross(w, d, axis=1)
+    A = data["Acceleration"][:, :, None] + np.cross(al, d, axis=1) + np.cross(w, wd, axis=1)
+    return P, A
 
 
 def _small_rotation(R, R0):
@@ -275,6 +340,7 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
         likely cause.
     """
     wall0 = _time.perf_counter()
+    cpu0 = _time.process_time()
     exu = __import__("exudyn")
     vp0: VehicleParams = load_vehicle(vehicle)
     try:
@@ -356,33 +422,24 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
                                 stiffness_factor=ctx.stiffness_factor)
 
     # ---- road input on the step grid
+    zr, zr_t = road_under_tyres(road_used, model, x_start, y_offset, s_steps,
+                                profile.speed(t_steps))
     nc = len(model.contacts)
-    xc = x_start + s_steps[:, None] + np.array([vp.axles[c.axle].x for c in model.contacts])[None, :]
-    yc = y_offset + np.array([c.y for c in model.contacts])[None, :]
-    zr = road_used.height(xc, np.broadcast_to(yc, xc.shape))
-    zr_t = np.gradient(zr, dt, axis=0) if n_steps >= 2 else np.zeros_like(zr)
     kc = np.array([c.stiffness for c in model.contacts])
     cc = np.array([c.damping for c in model.contacts])
     f_c = zr * kc + zr_t * cc
-    Bf, Bt = model.road_force_matrices()
-    F = f_c @ Bf.T
-    T = f_c @ Bt.T
     # start at static equilibrium on the road under the tyres at t = 0
-    model.set_road_forces((zr[0] * kc) @ Bf.T, (zr[0] * kc) @ Bt.T)
+    B = model.road_input_matrix()
+    model.set_injector(B @ (zr[0] * kc))
     model.solve_static()
-
-    loads = [(lf, lt, F[:, a].tolist(), T[:, a].tolist()) for a, (lf, lt) in enumerate(model.road_loads)]
+    Q = f_c @ B.T          # (n_steps + 1, n_injector): generalised road forces per step
+    Q = np.vstack([Q, Q[-1:], Q[-1:]])     # the solver may ask a hair beyond the end
     inv_dt = 1.0 / dt
-    kmax = n_steps
-    set_load = model.mbs.SetLoadParameter
+    set_obj = model.mbs.SetObjectParameter
+    inj = model.injector
 
-    def prestep(mbs, t):
-        k = int(t * inv_dt + 0.5)
-        if k > kmax:
-            k = kmax
-        for lf, lt, fa, ta in loads:
-            set_load(lf, "loadVector", [0.0, 0.0, fa[k]])
-            set_load(lt, "loadVector", [ta[k], 0.0, 0.0])
+    def prestep(mbs, t):   # t is the end of the step; keep this minimal (once per step)
+        set_obj(inj, "forceVector", Q[int(t * inv_dt + 0.5)])
         return True
 
     model.mbs.SetPreStepUserFunction(prestep)
@@ -406,6 +463,7 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
 
     solver = exu.MainSolverImplicitSecondOrder()
     solve0 = _time.perf_counter()
+    solve_cpu0 = _time.process_time()
     ok, err = False, ""
     from vehicles.builder import _quiet
     try:
@@ -414,6 +472,7 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     except Exception as exc:  # noqa: BLE001 - Exudyn raises several types
         err = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
     solve_s = _time.perf_counter() - solve0
+    solve_cpu = _time.process_time() - solve_cpu0
     t_fail = float(solver.it.currentTime)
     if not ok:
         raise SimulationError(_failure_message(t_fail, duration, eff, dt, err))
@@ -421,35 +480,43 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
 
     # ---- outputs
     data = {b.name: _sensor_arrays(model, b.name, n_out) for b in model.bodies}
+    # stored rows: the initial state and then every output period (possibly with
+    # repeated times); take the last row stored at each output time
     ts = data[model.segments[0].name]["t"]
-    keep = np.nonzero(np.abs(ts[:, None] - np.arange(n_out)[None, :] * t_out).min(axis=1) < 0.25 * dt)[0]
-    # stored rows: the initial state and every output period; take one row per output time
-    rows = []
-    for j in range(n_out):
-        hit = keep[np.abs(ts[keep] - j * t_out) < 0.25 * dt]
-        if hit.size == 0:
-            raise SimulationError(f"no output stored at t = {j * t_out:.4f} s (simulated up to "
-                                  f"{t_fail:.3f} s); likely cause: the solver stopped early")
-        rows.append(hit[-1])
-    rows = np.array(rows)
+    want = np.arange(n_out) * t_out
+    rows = np.searchsorted(ts, want + 0.25 * dt, side="right") - 1
+    if rows.min() < 0 or np.any(np.abs(ts[np.maximum(rows, 0)] - want) > 0.25 * dt):
+        j = int(np.nonzero((rows < 0) | (np.abs(ts[np.maximum(rows, 0)] - want) > 0.25 * dt))[0][0])
+        raise SimulationError(f"no output stored at t = {want[j]:.4f} s (simulated up to "
+                              f"{t_fail:.3f} s); likely cause: the solver stopped early")
     for name in data:
         for key in data[name]:
             data[name][key] = data[name][key][rows]
     time = np.arange(n_out) * t_out
 
-    channels, units = {}, {}
-    pos = {}
+    channels, pos = {}, {}
+    groups: dict = {}
     for ch, kind, body, wp in output_points(model):
-        b = model.body(body)
-        local = np.asarray(wp) - b.cog
-        p, a = _point_kinematics(data[body], local)
-        p_ref = _static_point(ref_model, body, wp)
-        if kind == "z_pos":
-            pos[ch] = p[:, 2] - p_ref[2]
-        elif kind == "z_acc":
-            channels[ch] = a[:, 2]
-        else:
-            pos[ch] = p - p_ref
+        groups.setdefault(body, []).append((ch, kind, np.asarray(wp, float)))
+    # contacts: dynamic deflection of the tyres (for the lift-off check)
+    for c, ct in enumerate(model.contacts):
+        ab = model.axles[ct.axle]
+        groups[ab.name].append((f"contact{c}", "z_pos_own", ab.cog + ct.local))
+    zc = np.empty((n_out, nc))
+    with np.errstate(all="ignore"):
+        for body, items in groups.items():
+            b = model.body(body)
+            L = np.array([wp - b.cog for _, _, wp in items])
+            P, A = _body_points(data[body], L)
+            for j, (ch, kind, wp) in enumerate(items):
+                if kind == "z_acc":
+                    channels[ch] = A[:, 2, j]
+                elif kind == "z_pos":
+                    pos[ch] = P[:, 2, j] - _static_point(ref_model, body, wp)[2]
+                elif kind == "yz_pos":
+                    pos[ch] = P[:, :, j] - _static_point(ref_model, body, wp)
+                else:   # tyre deflection relative to this model's own static state
+                    zc[:, int(ch[7:])] = P[:, 2, j] - _static_point(model, body, wp)[2]
     ordered = {}
     for a, ax in enumerate(vp.axles):
         for side in SIDES:
@@ -475,11 +542,6 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     # tyre forces (dynamic part) and lift-off
     k_out = np.arange(n_out) * n_sub
     zr_o, zr_t_o = zr[k_out], zr_t[k_out]
-    zc = np.empty((n_out, nc))
-    for c, ct in enumerate(model.contacts):
-        ab = model.axles[ct.axle]
-        p, _ = _point_kinematics(data[ab.name], ct.local)
-        zc[:, c] = p[:, 2] - _static_point(model, ab.name, ab.cog + ct.local)[2]
     zc_t = np.gradient(zc, t_out, axis=0)
     f_dyn = kc * (zr_o - zc) + cc * (zr_t_o - zc_t)
     f_static = model.static_tyre_loads()
@@ -492,6 +554,7 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
         EFFECTS[name].outputs(time, channels, p, ctx)
     units = {n: unit_of(n) for n in channels}
     wall = _time.perf_counter() - wall0
+    cpu = _time.process_time() - cpu0
     meta = {
         "vehicle": vp0.id, "vehicle_name": vp0.name, "chassis": model.chassis,
         "frame_segments": len(model.segments) if model.chassis == "flexible" else 1,
@@ -499,6 +562,7 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
         "effects": meta_eff, "effect_notes": dict(ctx.notes),
         "dt": dt, "fs_out": fs_out, "duration": duration, "steps": steps,
         "wall_s": wall, "solve_s": solve_s, "realtime_factor": duration / wall,
+        "cpu_s": cpu, "solve_cpu_s": solve_cpu, "cpu_realtime_factor": duration / cpu,
         "n_dof": model.n_dof, "n_bodies": len(model.bodies), "newton": nonlinear,
         "speed_mean": float(np.mean(profile.speed(time))), "distance_m": float(s_steps[-1]),
         "x_start": x_start, "y_offset": float(y_offset), "seed": seed,

@@ -1,0 +1,1 @@
+"""Built-in scenario files of ``eroad synth`` (TOML; see docs/measurement.md)."""

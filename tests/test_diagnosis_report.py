@@ -1,0 +1,75 @@
+"""The diagnosis report folder (diagnosis.report): summary.json contract, figures, atomic write."""
+import json
+
+import numpy as np
+import pytest
+
+from diagnosis import toy
+from diagnosis.compare import distribution_shape, front_rear, transmissibility
+from diagnosis.report import plot_heatmap, write_report
+from diagnosis.where import localize
+from diagnosis.which import rank_effects
+from eroad.errors import EroadInputError
+
+
+@pytest.fixture(scope="module")
+def results():
+    truth = toy.make_state({"sensor": {"cutoff_hz": 15.0}})
+    meas = toy.simulate_drive(truth, 60.0, 10.0, 3)
+    sim = toy.simulate(toy.fit({}, [meas]), meas, 4)
+    w = [meas.window(i * 20.0, (i + 1) * 20.0) for i in range(3)]
+    rank = rank_effects(toy.TOY_CANDIDATES[2:], toy.fit, toy.simulate, w[:1] + w[2:], w[1:2],
+                        seed=1, n_seeds=3, n_null=3, grid=4, refine=4, pairs=False)
+    return dict(localization=localize(meas, sim, segments=[("S1", 0, 30), ("S2", 30, 60)]),
+                transmissibility=transmissibility(meas, sim),
+                front_rear=front_rear(meas, sim, wheelbase=4.0),
+                shape=distribution_shape(meas, sim), ranking=rank)
+
+
+def test_report_folder_and_summary_contract(tmp_path, results):
+    """summary.json holds localization / ranking / verdict with the documented fields, is
+    strict JSON (no NaN), every figure listed exists and is a PNG, report.md links them."""
+    out = write_report(tmp_path / "run", meta={"dataset": "toy"}, **results)
+    s = json.loads((out / "summary.json").read_text())
+    assert s["verdict"] == results["ranking"].verdict
+    assert isinstance(s["verdict"], str)
+    loc = s["localization"]
+    assert len(loc) == 3 * 6 * 21
+    assert {"channel", "band_hz", "segment", "log_psd_ratio", "significant"} <= set(loc[0])
+    assert len(loc[0]["band_hz"]) == 2
+    for r in s["ranking"]:
+        assert {"effect", "parameters", "heldout_gap_before", "heldout_gap_after",
+                "shrink_fraction"} <= set(r)
+    assert [r["effect"] for r in s["ranking"]] == [e.effect for e in results["ranking"].entries]
+    md = (out / "report.md").read_text()
+    for name, rel in s["figures"].items():
+        assert (out / rel).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert rel in md
+    assert {"heatmap", "segments", "transmissibility", "ranking", "shrink"} <= set(s["figures"])
+    assert "## Where the gap lies" in md and "## Which effect" in md
+    json.loads((out / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
+
+
+def test_report_never_overwrites_without_force(tmp_path, results):
+    """An existing non-empty folder is refused (one-line input error) and left untouched;
+    with force it is replaced only after the new report is complete; no temp folder remains."""
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "mine.txt").write_text("keep")
+    with pytest.raises(EroadInputError, match="not empty"):
+        write_report(out, localization=results["localization"])
+    assert (out / "mine.txt").read_text() == "keep"
+    write_report(out, localization=results["localization"], force=True)
+    assert not (out / "mine.txt").exists() and (out / "summary.json").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]
+
+
+def test_figures_replot_from_saved_summary(tmp_path, results):
+    """Compute and plot apart: the heat map is drawn from summary.json alone."""
+    out = write_report(tmp_path / "run", localization=results["localization"])
+    s = json.loads((out / "summary.json").read_text())
+    p = plot_heatmap(s, tmp_path / "again.png", segment="S2")
+    assert p.stat().st_size > 1000
+    assert s["verdict"] == "none" and s["ranking"] == []
+    assert np.isfinite([r["log_psd_ratio"] for r in s["localization"]
+                        if r["log_psd_ratio"] is not None]).all()
