@@ -62,8 +62,9 @@ def register(subparsers) -> None:
                      help="luliang | random | null (default luliang, or from --config)")
     syn.add_argument("--seed", type=int, default=None, help="root seed (default 0)")
     syn.add_argument("--effect", action="append", default=[], metavar="NAME=VALUE",
-                     help="add an effect to the truth vehicle, e.g. leaf_friction=1.5 or "
-                     "payload.mass_kg=2000 (repeatable; 'eroad effects' lists them)")
+                     help="add an effect to the truth vehicle, e.g. leaf_friction=3000 or "
+                     "payload.mass=2000 or bump_stop.gap=0.02 (repeatable; 'eroad effects' "
+                     "lists them)")
     syn.add_argument("--no-default-effects", action="store_true",
                      help="drop the scenario's own effects (keep only --effect ones)")
     syn.add_argument("--vehicle", default=None,
@@ -144,7 +145,7 @@ def cmd_synth(args) -> int:
     else:
         print(f"wrote {summary['out']}: {summary['duration_s']:g} s at "
               f"{summary['sample_rate_hz']:g} Hz, {len(summary['channels']) - 1} channels + speed, "
-              f"{len(summary['segments'])} road segments, seed {summary['seed']} "
+              f"{len(summary['segments'])} road segment(s), seed {summary['seed']} "
               f"({summary['wall_s']:.1f} s wall)")
     return 0
 

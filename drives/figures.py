@@ -113,9 +113,9 @@ def plot_figures(drive: Drive, out_dir, *, window=None, channel: str = "susp_dis
     f_win, p_win, n_win = response_psd(xw, fs)
     fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
     sel_a, sel_w = f_all > 0, f_win > 0
-    ax.loglog(f_all[sel_a], p_all[sel_a], lw=0.9, label=f"whole record ({n_all} averages)")
+    ax.loglog(f_all[sel_a], p_all[sel_a], lw=0.9, label=f"whole record ({n_all} average{'s' * (n_all != 1)})")
     ax.loglog(f_win[sel_w], p_win[sel_w], lw=0.9,
-              label=f"window {t0:g}-{t1:g} s ({n_win} averages)")
+              label=f"window {t0:g}-{t1:g} s ({n_win} average{'s' * (n_win != 1)})")
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel(f"PSD of {channel} [{drive.units[channel]}$^2$/Hz]")
     ax.set_title(f"{drive.name}: spectrum before and after slicing")

@@ -219,8 +219,8 @@ class Drive:
 
     @property
     def duration_s(self) -> float:
-        """Record length N * dt [s]."""
-        return float(self.n_samples * self.dt)
+        """Record length N / sample_rate_hz [s] (one step more than last minus first time)."""
+        return float(self.n_samples / self.sample_rate_hz)
 
     @property
     def channel_names(self) -> list[str]:

@@ -35,6 +35,7 @@ import copy
 import json
 import math
 import os
+import re
 import shutil
 import time
 import tomllib
@@ -194,10 +195,13 @@ def _random_segments(rnd: dict, seed: int, duration: float, src) -> list[dict]:
     classes = list(rnd.get("classes", ["A", "B", "C", "D", "E"]))
     wlo, whi = (float(v) for v in rnd.get("w", [1.5, 2.5]))
     min_s = float(rnd.get("min_segment_s", 2.0))
+    # a short record holds fewer segments: at most duration / min_segment_s of them
+    kmax = min(kmax, int(math.floor(duration / min_s + 1e-9)))
+    kmin = min(kmin, kmax)
+    if kmax < 1:
+        raise EroadInputError(f"{src}: [road.random] min_segment_s = {min_s} s is longer than the "
+                              f"record ({duration} s)")
     k = int(rng.integers(kmin, kmax + 1))
-    if k * min_s >= duration:
-        raise EroadInputError(f"{src}: [road.random] {k} segments of at least {min_s} s do not "
-                              f"fit in {duration} s; lower min_segment_s or n_segments")
     shares = rng.dirichlet(np.ones(k))
     props = min_s / duration + (1.0 - k * min_s / duration) * shares
     segs = []
@@ -248,6 +252,8 @@ def resolve_scenario(cfg: dict, seed: int | None = None, *, effects=(), vehicle=
     sc["seed"] = int(seed)
     if vehicle is not None:
         sc["vehicle"] = str(vehicle)
+    if "vehicle" in sc and str(sc["vehicle"]).endswith(".toml"):
+        sc["vehicle"] = str(Path(sc["vehicle"]).resolve())  # the explicit scenario works anywhere
     if duration is not None:
         sc["duration_s"] = float(duration)
     for key, default in (("duration_s", None), ("sample_rate_hz", 200.0), ("start_time_s", 0.0),
@@ -479,9 +485,8 @@ def _jsonable(obj):
     return repr(obj)
 
 
-#: SimResult.meta keys that vary from run to run and stay out of truth/
-_VOLATILE = {"wall_s", "solve_s", "realtime_factor", "wall_time_s", "started", "finished",
-             "host"}
+#: SimResult.meta keys that vary from run to run (timings, host) stay out of truth/
+_VOLATILE = re.compile(r"wall|cpu|realtime|solve_s|elapsed|host|start(ed)?_at|finished|date")
 
 
 def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
@@ -536,7 +541,11 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
     names = [c for c in res.channels if parse_channel(c) is not None and c != "speed"]
     for c in names:
         clean[c] = np.asarray(res.channels[c], float)[sel]
-    clean["speed"] = plan["v_sim"][n_run:n_run + n_rec]
+    # the recorded speed: the simulator's channel (effects such as speed_scale act on it)
+    if "speed" in res.channels:
+        clean["speed"] = np.asarray(res.channels["speed"], float)[sel]
+    else:
+        clean["speed"] = plan["v_sim"][n_run:n_run + n_rec]
     noisy = add_noise(clean, cfg["noise"], seed)
 
     # the road puts each junction half-way between grid samples: the actual boundaries
@@ -555,7 +564,7 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
         d["dx_m"] = float(cfg["road"]["dx_m"])
         d["dy_m"] = float(cfg["road"]["dy_m"])
         segments.append(d)
-    sim_meta = {k: v for k, v in dict(getattr(res, "meta", {}) or {}).items() if k not in _VOLATILE}
+    sim_meta = {k: v for k, v in dict(getattr(res, "meta", {}) or {}).items() if not _VOLATILE.search(k)}
     truth = {
         "generator": "eroad synth (drives.synth)",
         "scenario": sc["name"],
@@ -703,7 +712,7 @@ def default_dataset(path=None) -> Path:
     """
     if path is None:
         root = Path(os.environ.get("EROAD_CACHE", DEFAULT_CACHE))
-        path = root / "datasets" / f"{DEFAULT_SCENARIO}-seed{DEFAULT_SEED}"
+        path = root / "datasets" / f"{Path(DEFAULT_SCENARIO).stem}-seed{DEFAULT_SEED}"
     path = Path(path)
     if (path / TRUTH_DIR / "summary.json").is_file():
         read_drive(path)  # raises with one line if the cache was damaged

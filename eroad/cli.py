@@ -22,6 +22,7 @@ from eroad.errors import EroadInputError, SimulationError
 COMMAND_MODULES = (
     "roadlib.cli",
     "vehicles.cli",
+    "vehicles.cli_modes",
     "drives.cli",
     "inverse.cli",
     "studies.cli",

@@ -188,7 +188,8 @@ def quarter_predict_rms(vehicle: QuarterTruckParams = QuarterTruckParams(), band
 
 def recovery_study(n_cases: int = 20, seed: int = 0, replicates: int = 1, oracle: bool = False,
                    known_noise: bool = False, min_len: float = 3.0, verbose: bool = False,
-                   config: InversionConfig = InversionConfig(), spec_kwargs=None) -> dict:
+                   config: InversionConfig = InversionConfig(), spec_kwargs=None,
+                   oracle_band: bool = False) -> dict:
     """Blind recovery of random scenarios on the quarter truck.
 
     Parameters
@@ -210,6 +211,10 @@ def recovery_study(n_cases: int = 20, seed: int = 0, replicates: int = 1, oracle
         Fit settings (its k, feature_spec and seed are set per case).
     spec_kwargs : dict, optional
         Extra :class:`FeatureSpec` settings.
+    oracle_band : bool
+        With ``oracle``: start nmin and nmax at the truth (a diagnostic of what
+        the freedom of the band parameters costs; hold them with a tiny
+        ``FitConfig.scale``).
 
     Returns
     -------
@@ -239,6 +244,8 @@ def recovery_study(n_cases: int = 20, seed: int = 0, replicates: int = 1, oracle
                 r = math.sqrt(np.mean([np.mean(band_pass(drive.channels[c], drive.fs, 0.2, 20.0)[sel] ** 2)
                                        for c in ("susp_disp_3L", "susp_disp_3R")]))
                 p0[k] = (classify(r, float(np.mean(drive.speed[sel])), pr, cfg.w0)[0], cfg.w0, cfg.nmin0, cfg.nmax0)
+                if oracle_band:
+                    p0[k, 2:] = P[k, 2:]
             fit = fit_segments(make(drive.t_bounds), feats, p0, seed=stream_seed(seed + i, SEED_KEY_FIT),
                                bounds=cfg.bounds.for_record(drive.fs, drive.speed.max()), config=cfg.fit)
             found_tb, fitted, idents = drive.t_bounds, fit.params, [s.identifiable for s in fit.segments]

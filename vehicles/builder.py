@@ -166,6 +166,7 @@ class Suspension:
     spring_type: str
     guide: tuple
     obj: int = -1
+    effect_obj: int = -1
     static_compression: float = float("nan")
 
 
@@ -404,8 +405,9 @@ class VehicleModel:
         exu = _exu()
         s = exu.SimulationSettings()
         s.staticSolver.verboseMode = 0
-        s.staticSolver.newton.relativeTolerance = 1e-10
-        s.staticSolver.newton.absoluteTolerance = 1e-8
+        # residual forces below 1e-3 N are round-off next to the 1e10 N/m frame joints
+        s.staticSolver.newton.relativeTolerance = 1e-9
+        s.staticSolver.newton.absoluteTolerance = 1e-3
         s.solution.file.write = False
         s.solution.sensors.active = False
         s.linearSolver.ignoreSingularJacobian = False
@@ -606,7 +608,6 @@ def build_model(vp: VehicleParams, chassis: str = "rigid", frame_segments: int |
                                                           localPosition=list(point)))
         return gm[key]
 
-    per_side = suspension_terms is not None
     for a, ax in enumerate(vp.axles):
         r = ax.tyre_radius
         ya = ax.track / 2
@@ -625,18 +626,13 @@ def build_model(vp: VehicleParams, chassis: str = "rigid", frame_segments: int |
             point = np.array([ax.x, sg * ax.spring_track / 2, ax.seat_height])
             stiff = [ax.guide_longitudinal_stiffness, ax.guide_lateral_stiffness, ax.spring_stiffness]
             damp = [GUIDE_DAMPING_TIME * stiff[0], GUIDE_DAMPING_TIME * stiff[1], ax.damping]
-            obj = -1
-            if per_side:
-                m0, m1 = pos_marker(seg, point), pos_marker(body, point)
-                obj = mbs.AddObject(ii.ObjectConnectorCartesianSpringDamper(
-                    markerNumbers=[m0, m1], stiffness=stiff, damping=damp))
             k_susp.append(stiff)
             c_susp.append(damp)
             pts_susp.append(point - seat_c)
             model.suspensions.append(Suspension(
                 axle=a, side=side, point=point, segment=seg_i, local_frame=point - seg.cog,
                 local_axle=point - body.cog, stiffness=ax.spring_stiffness, damping=ax.damping,
-                spring_type=ax.spring_type, guide=(stiff, damp), obj=obj))
+                spring_type=ax.spring_type, guide=(stiff, damp)))
             offsets = [0.0] if ax.tyres_per_side == 1 else [-ax.dual_spacing / 2, ax.dual_spacing / 2]
             for o in offsets:
                 y = sg * ya + o
@@ -655,22 +651,17 @@ def build_model(vp: VehicleParams, chassis: str = "rigid", frame_segments: int |
         for ct in model.contacts[first_contact:]:
             ct.obj = obj
         # suspension (both sides, guides) and axle wind-up (pitch relative to the frame:
-        # leaf-spring bending or torque rods): one 6-DOF spring-damper at the seat centre,
-        # or, with extra suspension terms, per-side Cartesian elements plus the wind-up
+        # leaf-spring bending or torque rods): one 6-DOF spring-damper at the seat centre
         Kw = np.zeros((6, 6))
         Kw[4, 4] = ax.windup_stiffness
-        if per_side:
-            Ks, Cs = Kw, GUIDE_DAMPING_TIME * Kw
-        else:
-            Ks = equivalent_6x6(pts_susp, k_susp) + Kw
-            Cs = equivalent_6x6(pts_susp, c_susp) + GUIDE_DAMPING_TIME * Kw
+        Ks = equivalent_6x6(pts_susp, k_susp) + Kw
+        Cs = equivalent_6x6(pts_susp, c_susp) + GUIDE_DAMPING_TIME * Kw
         obj = mbs.AddObject(ii.ObjectConnectorRigidBodySpringDamper(
             markerNumbers=[rigid_marker(seg, seat_c), rigid_marker(body, seat_c)],
             stiffness=Ks, damping=Cs))
         model.joints.append(obj)
-        if not per_side:
-            for su in model.suspensions[-2:]:
-                su.obj = obj
+        for su in model.suspensions[-2:]:
+            su.obj = obj
         # road input: vertical force at the wheel-centre line and roll moment (global)
         mline = pos_marker(body, [ax.x, 0.0, r])
         lf = mbs.AddLoad(ii.LoadForceVector(markerNumber=mline, loadVector=[0.0, 0.0, 0.0]))
@@ -724,47 +715,62 @@ def build_model(vp: VehicleParams, chassis: str = "rigid", frame_segments: int |
     return model
 
 
+def _suspension_uf(terms, s0):
+    """Symbolic-recordable spring-force function of one effect element."""
+    def uf(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        u = displacement[2] - s0
+        v = velocity[2]
+        fz = terms[0](u, v)
+        for term in terms[1:]:
+            fz = fz + term(u, v)
+        return [0.0 * u, 0.0 * u, fz]
+    return uf
+
+
 def install_suspension_terms(model: VehicleModel, suspension_terms) -> int:
-    """Replace the linear suspension law by a symbolic user function with extra terms.
+    """Add the extra (nonlinear) suspension forces of effects, one element per side.
+
+    Each axle side with terms gets a Cartesian spring-damper with zero stiffness and
+    damping between its frame and axle spring seats, whose force is a symbolic user
+    function (recorded once, evaluated in C++) of the dynamic compression ``u``
+    (zero at static equilibrium) and the compression velocity ``v``.  The linear
+    suspension stays in the axle's 6-DOF spring-damper, so switching an effect on
+    changes nothing but the effect's own force.  Positive forces push axle and frame
+    apart (like the spring in compression).
 
     Parameters
     ----------
     model : VehicleModel
-        Must be at static equilibrium (``static_compression`` known).
+        At static equilibrium (``static_compression`` known).
     suspension_terms : callable
         ``f(suspension) -> list of term(u, v)`` (see :func:`build_model`).
 
     Returns
     -------
     int
-        Number of suspension elements that got a user function.
+        Number of effect elements added.
     """
-    exu = _exu()
+    from exudyn import itemInterface as ii
     from exudyn.advancedUtilities import CreateSymbolicUserFunction
 
+    mbs = model.mbs
     n = 0
-    for s in model.suspensions:
-        terms = [t for t in (suspension_terms(s) or []) if t is not None]
+    for su in model.suspensions:
+        terms = [t for t in (suspension_terms(su) or []) if t is not None]
         if not terms:
             continue
-        s0 = float(s.static_compression)
-
-        def uf(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset,
-               _terms=terms, _s0=s0):
-            u = displacement[2] - _s0
-            v = velocity[2]
-            fz = stiffness[2] * displacement[2] + damping[2] * v
-            for term in _terms:
-                fz = fz + term(u, v)
-            return [stiffness[0] * displacement[0] + damping[0] * velocity[0],
-                    stiffness[1] * displacement[1] + damping[1] * velocity[1], fz]
-
-        sym = CreateSymbolicUserFunction(model.mbs, uf, "springForceUserFunction",
+        sym = CreateSymbolicUserFunction(mbs, _suspension_uf(terms, float(su.static_compression)),
+                                         "springForceUserFunction",
                                          itemTypeName="ObjectConnectorCartesianSpringDamper")
         model._keep.append(sym)
-        model.mbs.SetObjectParameter(s.obj, "springForceUserFunction", sym)
+        seg, ax = model.segments[su.segment], model.axles[su.axle]
+        m0 = mbs.AddMarker(ii.MarkerBodyPosition(bodyNumber=seg.body, localPosition=list(su.local_frame)))
+        m1 = mbs.AddMarker(ii.MarkerBodyPosition(bodyNumber=ax.body, localPosition=list(su.local_axle)))
+        su.effect_obj = mbs.AddObject(ii.ObjectConnectorCartesianSpringDamper(
+            markerNumbers=[m0, m1], stiffness=[0.0, 0.0, 0.0], damping=[0.0, 0.0, 0.0],
+            springForceUserFunction=sym))
         n += 1
     if n:
-        model.mbs.Assemble()
-    _ = exu
+        mbs.Assemble()
+        model.solve_static()
     return n

@@ -56,6 +56,12 @@ coherence ``gamma`` is
   ``r = 2 pi n |dy| / lam`` (for w = 2: ``r K_1(r)``);
 * a callable ``gamma(n [cycles/m], dy [m]) -> [-]``.
 
+With the ``tyre_enveloping`` effect the road PSD is multiplied by ``sinc(n L)^2``
+(moving average over the footprint length L).  A road given on a grid and
+interpolated linearly (``RoadSurface.height``) carries less power than its PSD near
+its Nyquist frequency (about ``sinc(n dx)^4``): use a grid step well below the
+shortest wavelength that matters (dx <= 1/(10 nmax)) when comparing with simulations.
+
 Units: SI throughout; frequencies in Hz, spatial frequencies in cycles/m.
 """
 from __future__ import annotations
@@ -125,6 +131,9 @@ class LinearModel:
         ``{body name: ndarray of coordinate indices}``.
     meta : dict
         Vehicle id, chassis, stiffness factor, frame segments, effects, n_dof.
+    footprint : float
+        Tyre footprint length [m] of the ``tyre_enveloping`` effect (0: none): the road
+        input is filtered by the moving average ``sinc(n L) = sin(pi n L) / (pi n L)``.
     """
 
     vp: object
@@ -140,6 +149,7 @@ class LinearModel:
     dof_names: list
     body_dofs: dict
     meta: dict = field(default_factory=dict)
+    footprint: float = 0.0
 
     # ------------------------------------------------------------------ basics
     @property
@@ -296,6 +306,8 @@ class LinearModel:
             raise EroadInputError(f"unknown coherence model {coherence!r}; use one of "
                                   f"{', '.join(COHERENCE_MODELS)} or a callable gamma(n, dy)")
         E = np.exp(1j * 2 * np.pi * f[:, None, None] * (xs[:, None] - xs[None, :])[None] / v)
+        if self.footprint > 0:
+            G = G * np.sinc(n * self.footprint) ** 2
         return G[:, None, None] * gam * E
 
     def response_psd(self, road, speed: float, freqs, coherence="surface", channels=None) -> dict:
@@ -627,6 +639,40 @@ def _load_generalized_force(model, kin: _Kinematics, load: int) -> np.ndarray:
     raise RuntimeError(f"unexpected road load type {kind!r} (load {load}, vector {vec})")  # pragma: no cover
 
 
+def road_input_matrix(model, kin: _Kinematics | None = None, from_loads: bool = False) -> np.ndarray:
+    """Generalised force per newton of road force under each tyre, (n, n_contacts).
+
+    The builder's own map (``VehicleModel.road_input_matrix_global``, the one the
+    simulation's road-force injector uses) when it has one; otherwise, or with
+    ``from_loads``, the generalised forces of the builder's road loads (a vertical
+    force at the axle's centre line and a roll moment ``y_c f_c`` per axle,
+    ``VehicleModel.road_force_matrices``), computed here from the kinematics.
+
+    Parameters
+    ----------
+    model : vehicles.builder.VehicleModel
+    kin : _Kinematics, optional
+    from_loads : bool
+
+    Returns
+    -------
+    ndarray (n, n_contacts)
+        [1] for translations, [m] for rotations (generalised force per N).
+    """
+    if not from_loads and hasattr(model, "road_input_matrix_global"):
+        return np.asarray(model.road_input_matrix_global(), float)
+    kin = kin or _Kinematics(model)
+    Bf, Bt = model.road_force_matrices()
+    qf = [_load_generalized_force(model, kin, lf) for lf, _ in model.road_loads]
+    qt = [_load_generalized_force(model, kin, lt) for _, lt in model.road_loads]
+    nc = len(model.contacts)
+    B = np.zeros((kin.n, nc))
+    for c in range(nc):
+        for a in range(len(model.axles)):
+            B[:, c] += Bf[a, c] * qf[a] + Bt[a, c] * qt[a]
+    return B
+
+
 def _outputs(model, kin: _Kinematics) -> list:
     from vehicles.simulate import output_points
 
@@ -670,12 +716,16 @@ def configured_build(vp, chassis: str = "rigid", frame_segments: int | None = No
 
     Effects change the vehicle or chassis through :meth:`Effect.configure` (payload,
     frame flexibility, ...); suspension terms are installed so that Exudyn linearises
-    them at rest; road and output hooks (enveloping, sensor, speed scale) do not
-    apply to the linear model.
+    them at rest (a smoothed Coulomb friction becomes a large viscous damping -- the
+    stuck suspension -- a bump stop with a gap does nothing, an asymmetric damper
+    its mean); ``tyre_enveloping`` becomes the footprint filter of the road input
+    (:attr:`LinearModel.footprint`); other road and output hooks (sensor dynamics,
+    speed scale) are not part of the linear model and are listed in the notes.
 
     Returns
     -------
-    (model, ctx, notes) : VehicleModel, EffectContext, list of str
+    (model, ctx, notes, effects) : VehicleModel, EffectContext, list of str, dict
+        ``effects`` are the resolved effect parameters.
     """
     from vehicles.builder import build_model
     from vehicles.effects import EFFECTS, resolve_effects
@@ -690,8 +740,8 @@ def configured_build(vp, chassis: str = "rigid", frame_segments: int | None = No
     for name, p in eff.items():
         EFFECTS[name].configure(ctx, p)
         e = type(EFFECTS[name])
-        if e.road is not Effect.road or e.outputs is not Effect.outputs:
-            notes.append(f"effect {name}: road/output hooks are not part of the linear model")
+        if name != "tyre_enveloping" and (e.road is not Effect.road or e.outputs is not Effect.outputs):
+            notes.append(f"effect {name}: its road/output hook is not part of the linear model")
         if EFFECTS[name].nonlinear:
             notes.append(f"effect {name}: nonlinear, linearised at rest (static equilibrium)")
     terms_of = None
@@ -730,14 +780,7 @@ def linear_model(vp, chassis: str = "rigid", frame_segments: int | None = None,
     model, ctx, notes, eff = configured_build(vp, chassis, frame_segments, stiffness_factor, effects)
     M, K, D = model.linearized_system()
     kin = _Kinematics(model)
-    Bf, Bt = model.road_force_matrices()
-    qf = [_load_generalized_force(model, kin, lf) for lf, _ in model.road_loads]
-    qt = [_load_generalized_force(model, kin, lt) for _, lt in model.road_loads]
-    nc = len(model.contacts)
-    Bunit = np.zeros((M.shape[0], nc))
-    for c in range(nc):
-        for a in range(len(model.axles)):
-            Bunit[:, c] += Bf[a, c] * qf[a] + Bt[a, c] * qt[a]
+    Bunit = road_input_matrix(model, kin)
     kc = np.array([c.stiffness for c in model.contacts])
     cc = np.array([c.damping for c in model.contacts])
     idx = kin.idx
@@ -750,10 +793,12 @@ def linear_model(vp, chassis: str = "rigid", frame_segments: int | None = None,
     meta = {"vehicle": ctx.vp.id, "chassis": model.chassis, "stiffness_factor": model.stiffness_factor,
             "frame_segments": len(model.segments) if model.chassis == "flexible" else 1,
             "effects": {k: dict(v) for k, v in eff.items()}, "notes": notes, "n_dof": int(M.shape[0])}
+    footprint = float(eff["tyre_enveloping"]["length"]) if "tyre_enveloping" in eff else 0.0
     return LinearModel(vp=ctx.vp, chassis=model.chassis, model=model, M=M, K=K, D=D,
                        Bk=Bunit * kc[None, :], Bc=Bunit * cc[None, :], contacts=contacts,
                        outputs=_outputs(model, kin), dof_names=dof_names,
-                       body_dofs={k: np.asarray(v) for k, v in idx.items()}, meta=meta)
+                       body_dofs={k: np.asarray(v) for k, v in idx.items()}, meta=meta,
+                       footprint=footprint)
 
 
 def response_psd(vp, road_params, speed: float, freqs, coherence="surface", chassis: str = "rigid",

@@ -207,8 +207,26 @@ def _kind_of(name: str) -> str:
     return "other"
 
 
+#: components of a 6-DOF spring-damper (x, y, z, rot x, rot y, rot z) per group, by the
+#: kinds of the two bodies it joins; Cartesian spring-dampers use the first three
+_GROUPS_6 = {
+    ("axle", "ground"): {"tyre vertical": (2, 3), "tyre horizontal": (0, 1, 4, 5)},
+    ("axle", "segment"): {"suspension": (2, 3), "axle guides": (0, 1, 4, 5)},
+    ("ground", "segment"): {"surge": (0, 1, 2, 3, 4, 5)},
+    ("segment", "segment"): {"frame joint translation": (0, 1, 2), "frame torsion": (3,),
+                             "frame bending": (4,), "frame lateral": (5,)},
+    ("dcdc", "segment"): {"DCDC mounts": (0, 1, 2, 3, 4, 5)},
+}
+
+
 def element_groups(model) -> dict:
     """Force-element stiffness components of the model, grouped.
+
+    Elements are recognised by the kinds of the two bodies they join (ground, frame
+    segment or chassis, axle, DCDC) and split by component: for the tyres and the
+    suspension, vertical and roll (z, rot x) against the horizontal guiding
+    directions (x, y, rot y, rot z); for the frame joints, translation, torsion
+    (rot x), vertical bending (rot y) and lateral bending (rot z).
 
     Parameters
     ----------
@@ -217,9 +235,10 @@ def element_groups(model) -> dict:
     Returns
     -------
     dict
-        ``{group: [(object number, component index, kind), ...]}`` with kind
-        ``"vector"`` (Cartesian spring-damper: x, y, z) or ``"matrix"`` (rigid-body
-        spring-damper: the diagonal entry of its 6x6 stiffness).
+        ``{group: [(object number, components, kind), ...]}`` with kind ``"vector"``
+        (Cartesian spring-damper, components of x, y, z) or ``"matrix"`` (rigid-body
+        spring-damper, rows of its 6x6 stiffness).  Elements that fit no rule (effect
+        elements with user functions, ...) are not listed: their share is ``other``.
     """
     mbs = model.mbs
     names = _body_names(model)
@@ -227,43 +246,31 @@ def element_groups(model) -> dict:
     for i in range(mbs.systemData.NumberOfObjects()):
         o = mbs.GetObject(i)
         typ = o.get("objectType", "")
-        if "markerNumbers" not in o or typ not in ("ConnectorCartesianSpringDamper",
-                                                    "ConnectorRigidBodySpringDamper"):
-            continue
-        kinds = sorted(_kind_of(names.get(int(mbs.GetMarker(m)["bodyNumber"]), "other"))
-                       for m in o["markerNumbers"])
-        pair = tuple(kinds)
         if typ == "ConnectorCartesianSpringDamper":
-            for c in range(3):
-                if pair == ("axle", "ground"):
-                    g = "tyre vertical" if c == 2 else "tyre horizontal"
-                elif pair == ("ground", "segment"):
-                    g = "surge"
-                elif pair == ("axle", "segment"):
-                    g = "suspension" if c == 2 else "axle guides"
-                else:
-                    g = "other"
-                groups[g].append((i, c, "vector"))
+            kind, ncomp = "vector", 3
+        elif typ == "ConnectorRigidBodySpringDamper":
+            kind, ncomp = "matrix", 6
         else:
-            for c in range(6):
-                if pair == ("segment", "segment"):
-                    g = ("frame joint translation",) * 3 + ("frame torsion", "frame bending", "frame lateral")
-                    g = g[c]
-                elif pair == ("axle", "segment"):
-                    g = "axle guides"
-                elif pair == ("dcdc", "segment"):
-                    g = "DCDC mounts"
-                else:
-                    g = "other"
-                groups[g].append((i, c, "matrix"))
+            continue
+        if kind == "vector" and o.get("springForceUserFunction", 0) not in (0, None):
+            continue
+        pair = tuple(sorted(_kind_of(names.get(int(mbs.GetMarker(m)["bodyNumber"]), "other"))
+                            for m in o["markerNumbers"]))
+        for g, comps in _GROUPS_6.get(pair, {}).items():
+            comps = tuple(c for c in comps if c < ncomp)
+            if comps:
+                groups[g].append((i, comps, kind))
     return {g: v for g, v in groups.items() if v}
 
 
 def group_stiffness(model, K: np.ndarray) -> dict:
     """Stiffness contribution ``K_g`` of every element group (see :func:`element_groups`).
 
-    ``K_g = K - K(group stiffness set to zero)``, both linearised by Exudyn at the
-    same (static) state; the parameters are restored afterwards.
+    ``K_g = K - K'`` with ``K'`` linearised by Exudyn at the same (static) state after
+    zeroing the group's components: entries of a Cartesian stiffness vector, rows of
+    a 6x6 stiffness matrix (so that an energy cross term between two groups is
+    shared half and half).  The parameters are restored afterwards.  ``K_g``
+    includes the geometric stiffness of the group's preload.
 
     Returns
     -------
@@ -274,15 +281,16 @@ def group_stiffness(model, K: np.ndarray) -> dict:
     out = {}
     for g, items in element_groups(model).items():
         saved = {}
-        for obj, c, kind in items:
+        for obj, comps, kind in items:
             if obj not in saved:
                 saved[obj] = np.array(mbs.GetObjectParameter(obj, "stiffness"), float)
         new = {obj: v.copy() for obj, v in saved.items()}
-        for obj, c, kind in items:
-            if kind == "vector":
-                new[obj][c] = 0.0
-            else:
-                new[obj][c, c] = 0.0
+        for obj, comps, kind in items:
+            for c in comps:
+                if kind == "vector":
+                    new[obj][c] = 0.0
+                else:
+                    new[obj][c, :] = 0.0
         try:
             for obj, v in new.items():
                 mbs.SetObjectParameter(obj, "stiffness", v)
