@@ -51,7 +51,14 @@ class InversionConfig:
         Before the Nyquist cap (applied from the record).
     w0, nmin0, nmax0 : float
         Initial w [-], nmin and nmax [cycles/m] of every segment (the level comes
-        from the segmentation); also the prior mean.
+        from the segmentation).  The band starts INSIDE the range the response
+        is sensitive to (nmin0 * v and nmax0 * v within the feature bands), so
+        the data push its edges outwards as far as they can tell; an edge
+        started outside that range would have no sensitivity and never move.
+    w_prior, nmin_prior, nmax_prior : float
+        Prior mean of w, nmin, nmax (the level's prior mean is the
+        segmentation's level); defaults are the typical values of the paper's
+        Table 1.
     seed : int
         Root seed (see module docstring).
     """
@@ -62,8 +69,11 @@ class InversionConfig:
     fit: FitConfig = FitConfig()
     bounds: ParamBounds = ParamBounds()
     w0: float = 2.0
-    nmin0: float = 0.05
-    nmax0: float = 5.0
+    nmin0: float = 0.1
+    nmax0: float = 2.5
+    w_prior: float = 2.0
+    nmin_prior: float = 0.05
+    nmax_prior: float = 5.0
     seed: int = 0
 
 
@@ -167,12 +177,14 @@ def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
     K = seg.n_segments
     Gq0 = np.where(np.isfinite(seg.Gq_init), seg.Gq_init, 256e-6)
     params0 = np.column_stack([Gq0, np.full(K, config.w0), np.full(K, config.nmin0), np.full(K, config.nmax0)])
+    prior = np.column_stack([Gq0, np.full(K, config.w_prior), np.full(K, config.nmin_prior),
+                             np.full(K, config.nmax_prior)])
     fs = 1.0 / float(np.mean(np.diff(t)))
     v_max = float(np.max(np.broadcast_to(np.asarray(speed, float), t.shape)))
     bounds = config.bounds.for_record(fs, v_max)
     simulate = make_simulator(seg.t_bounds)
     fit = fit_segments(simulate, feats, params0, seed=stream_seed(config.seed, SEED_KEY_FIT),
-                       bounds=bounds, config=config.fit, map_fn=map_fn, progress=progress)
+                       bounds=bounds, config=config.fit, prior=prior, map_fn=map_fn, progress=progress)
     return Inversion(t, seg, feats, fit, params0, config)
 
 

@@ -246,8 +246,13 @@ def recovery_study(n_cases: int = 20, seed: int = 0, replicates: int = 1, oracle
                 p0[k] = (classify(r, float(np.mean(drive.speed[sel])), pr, cfg.w0)[0], cfg.w0, cfg.nmin0, cfg.nmax0)
                 if oracle_band:
                     p0[k, 2:] = P[k, 2:]
+            prior = p0.copy()
+            prior[:, 1:] = (cfg.w_prior, cfg.nmin_prior, cfg.nmax_prior)
+            if oracle_band:
+                prior[:, 2:] = P[:, 2:]
             fit = fit_segments(make(drive.t_bounds), feats, p0, seed=stream_seed(seed + i, SEED_KEY_FIT),
-                               bounds=cfg.bounds.for_record(drive.fs, drive.speed.max()), config=cfg.fit)
+                               bounds=cfg.bounds.for_record(drive.fs, drive.speed.max()), config=cfg.fit,
+                               prior=prior)
             found_tb, fitted, idents = drive.t_bounds, fit.params, [s.identifiable for s in fit.segments]
             n_sims = fit.n_sims
         else:

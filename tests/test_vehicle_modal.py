@@ -1,7 +1,7 @@
 """Modal analysis (vehicles.modal): frequency ranges, labels, rigid limit, stiffness scaling, CLI.
 
 Reference ranges are those of heavy road vehicles (Cebon, Handbook of Vehicle-Road
-Interaction, 1999, ch. 5; Gillespie, Fundamentals of Vehicle Dynamics, ch. 5): body
+Interaction, 1999; Gillespie, Fundamentals of Vehicle Dynamics, 1992, ride chapter): body
 bounce 1-3 Hz, pitch 1.5-4 Hz, axle hop 8-15 Hz, axle tramp (roll) 8-20 Hz, frame
 torsion and vertical bending 5-15 Hz.  Body roll is checked against a hand
 calculation (see ``test_body_roll_matches_hand_calculation``) because the loaded
@@ -68,7 +68,7 @@ def test_body_and_axle_modes_in_physical_ranges(results, vehicle, chassis):
 
 @pytest.mark.parametrize("vehicle", VEHICLES)
 def test_body_roll_matches_hand_calculation(results, vehicle):
-    """Body roll against the textbook estimate (Gillespie ch. 8): sprung mass rolling
+    """Body roll against the textbook estimate (Gillespie, roll stiffness): sprung mass rolling
     about the spring-seat height on the suspension roll stiffness (springs at the
     spring track in series with the tyres at their lateral positions), reduced by
     the gravity term m g h, with inertia J_x + m h^2 (h: centre of gravity above the

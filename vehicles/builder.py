@@ -18,20 +18,26 @@ road; the vehicle does not move along x: the road moves under it):
   elastic in torsion (about x), vertical bending (about y) and lateral bending
   (about z) (``chassis="flexible"``, :mod:`vehicles.frame`);
 * axles: rigid 6-DOF bodies; bounce and roll are the soft motions, the other four
-  are held by the stiff axle guides and the tyres;
-* suspension: per axle side one Cartesian spring-damper between the spring seat on
-  the frame and on the axle, vertical spring and damper of the suspension, stiff
-  longitudinal and lateral guide;
-* axle wind-up: a rotational spring about y between axle and frame (leaf-spring
-  bending or torque rods);
-* tyres: per tyre (two for a dual pair at +-dual_spacing/2) one Cartesian
-  spring-damper from the wheel centre to the ground: vertical tyre stiffness and
-  damping, lateral tyre stiffness (no longitudinal stiffness: the wheels roll).  The element sits at the wheel
-  centre because the contact of a rolling wheel stays below the wheel centre
-  whatever the wheel's spin; a body-fixed contact point would let the preloaded
-  vertical tyre force destabilise the axle's pitch (the lever arm of the lateral
-  tyre force, tyre radius x lateral force, is neglected).  The road enters
-  as a force: a tyre force ``k (z_r - u) + c (dz_r/dt - du/dt)`` is the constant
+  are held by the stiff axle guides, the wind-up spring and the tyres;
+* suspension: per axle side a vertical spring and damper (and a stiff longitudinal
+  and lateral guide) between the spring seat on the frame and on the axle, plus
+  the axle's wind-up (pitch relative to the frame: leaf-spring bending, torque
+  rods).  Both sides and the wind-up of an axle are one 6-DOF spring-damper
+  (``ObjectConnectorRigidBodySpringDamper``) at the centre of the seats whose 6x6
+  stiffness and damping are those of the point springs (:func:`equivalent_6x6`,
+  exact for small motions): one element per axle instead of three, which halves
+  the cost of a time step.  ``model.suspensions`` keeps the per-side data;
+  nonlinear effects add their per-side forces as separate elements
+  (:func:`install_suspension_terms`);
+* tyres: the tyres of an axle (per side one, or two for a dual pair at
+  +-dual_spacing/2) are likewise one 6-DOF spring-damper from the axle centre to
+  the ground, equivalent to a vertical (stiffness, damping) and lateral
+  (stiffness) spring at every wheel centre; no longitudinal stiffness: the wheels
+  roll.  At the wheel centre, because the contact of a rolling wheel stays below
+  the wheel centre whatever the wheel's spin (a body-fixed contact point would let
+  the preloaded tyre force destabilise the axle's pitch; the lever arm of the
+  lateral tyre force, radius x lateral force, is neglected).  The road enters as a
+  force: a tyre force ``k (z_r - u) + c (dz_r/dt - du/dt)`` is the constant
   spring-damper ``-k u - c du/dt`` plus the known force ``k z_r + c dz_r/dt``; the
   road forces of all tyres of an axle are one vertical force at the wheel-centre
   line plus one roll moment (``road_loads``, two loads per axle).  In the time
@@ -134,7 +140,7 @@ class Contact:
     stiffness, damping : float
         Vertical tyre stiffness [N/m] and damping [N s/m].
     obj : int
-        Exudyn object number of the tyre spring-damper.
+        Exudyn object number of the axle's tyre spring-damper (shared by its tyres).
     """
 
     axle: int
@@ -148,11 +154,32 @@ class Contact:
 
 @dataclass
 class Suspension:
-    """Suspension spring-damper of one axle side.
+    """Suspension of one axle side.
 
     ``u = z(axle seat) - z(frame seat)`` is the compression [m] (positive when the
     axle moves up relative to the frame), measured from the unloaded design
     position; ``static_compression`` is its value at static equilibrium.
+
+    Attributes
+    ----------
+    axle, side
+        Axle index (0-based) and ``"L"``/``"R"``.
+    point : ndarray (3,)
+        Spring seat in vehicle coordinates (design position) [m].
+    segment : int
+        Index of the frame segment (0 for the rigid chassis) carrying the seat.
+    local_frame, local_axle : ndarray (3,)
+        The seat relative to the segment's / axle's centre of gravity [m].
+    stiffness, damping : float
+        Vertical spring [N/m] and (mean) damping [N s/m].
+    spring_type : str
+        ``"leaf"`` or ``"air"``.
+    guide : tuple
+        ([kx, ky, kz], [cx, cy, cz]) of the side's point spring-damper.
+    obj : int
+        The axle's 6-DOF suspension element (shared by both sides).
+    effect_obj : int
+        The side's effect element (nonlinear effects), or -1.
     """
 
     axle: int

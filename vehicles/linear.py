@@ -23,10 +23,12 @@ constraints) is linearised at its static equilibrium by
 with ``q`` the ODE2 coordinates (6 per body: displacement of the centre of gravity
 and Tait-Bryan angles) and ``z_r`` (n_contacts,) the road heights under the tyres.
 A tyre force is ``k_t (z_r - u) + c_t (z_r' - u')``: the ``-k_t u - c_t u'`` part is in
-``K`` and ``D``, the known part ``k_t z_r + c_t z_r'`` enters through the builder's road
-loads (vertical force at the axle centre line plus roll moment per axle,
-``VehicleModel.road_force_matrices``), whose generalised forces are ``Bk`` (times
-``k_t``) and ``Bc`` (times ``c_t``).  Outputs are linear in ``q``: a body-fixed point
+``K`` and ``D``, the known part ``k_t z_r + c_t z_r'`` enters as generalised forces
+``B (k_t z_r + c_t z_r')`` with ``B`` the builder's road-input map (the one the
+simulation's force injector uses, :func:`road_input_matrix`; it equals the
+generalised forces of the builder's road loads: vertical force at the axle centre
+line plus roll moment per axle), so ``Bk = B diag(k_t)``, ``Bc = B diag(c_t)``.
+Outputs are linear in ``q``: a body-fixed point
 moves by ``dp = J_p dq``, ``J_p = [I, -[R r]x G]`` with ``G`` the map from angle rates to
 the angular velocity; accelerations are ``-omega^2`` times displacements (the
 centripetal terms are of second order).  The points are those of
@@ -703,10 +705,9 @@ def _outputs(model, kin: _Kinematics) -> list:
         top = np.array([d.x, d.y, d.z_base + d.height]) - b.cog
         T = kin.point("dcdc", top)
         Rj = kin.rotation("dcdc")
-        for j, name in enumerate(("dcdc_Tx", "dcdc_Ty", "dcdc_Tz")):
-            outs.append(OutputChannel(name, "m", T[j], 0))
-        for j, name in enumerate(("dcdc_Rx", "dcdc_Ry", "dcdc_Rz")):
-            outs.append(OutputChannel(name, "rad", Rj[j], 0))
+        rows6 = list(T) + list(Rj)
+        for j, (name, unit) in enumerate(DCDC_MOTIONS.items()):
+            outs.append(OutputChannel(name, unit, rows6[j], 0))
     return outs
 
 

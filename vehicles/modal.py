@@ -325,7 +325,6 @@ class _EnergyMap:
         self.M = lm.M
         idx = lm.body_dofs
         self.sprung = [b for b in model.segments] + ([model.dcdc] if model.dcdc is not None else [])
-        self.seg_names = [b.name for b in model.segments]
         self.s_idx = np.concatenate([idx[b.name] for b in self.sprung])
         cogs = np.array([b.cog for b in self.sprung])
         masses = np.array([b.mass for b in self.sprung])

@@ -70,7 +70,8 @@ class Axle:
     tyre_stiffness: float = _f("N/m", "vertical stiffness of one tyre")
     tyre_damping: float = _f("N s/m", "vertical damping of one tyre")
     tyre_lateral_stiffness: float = _f("N/m", "lateral stiffness of one tyre at the contact")
-    tyre_contact_length: float = _f("m", "length of the contact patch (default of `tyre_enveloping`)")
+    tyre_contact_length: float = _f("m", "length of the contact patch (mean over axles: default of "
+                                          "`tyre_enveloping`)")
     spring_type: str = _f("-", "'leaf' or 'air' (leaf springs carry inter-leaf friction)")
     spring_track: float = _f("m", "lateral distance between the left and right spring seats")
     seat_height: float = _f("m", "height of the spring seats (spring-damper attachment, roll centre)")

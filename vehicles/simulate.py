@@ -276,13 +276,20 @@ def _body_points(data, L):
     (P, A) : ndarrays (n, 3, m)
         Positions [m] and accelerations [m/s^2] (a + alpha x d + omega x (omega x d)).
     """
-    d = np.einsum("nij,mj->nim", data["RotationMatrix"], L)
+    d = np.matmul(data["RotationMatrix"], np.ascontiguousarray(L.T))       # (n, 3, m)
     P = data["Position"][:, :, None] + d
     w = data["AngularVelocity"][:, :, None]
     al = data["AngularAcceleration"][:, :, None]
-    wd = np.cross(w, d, axis=1)
-    A = data["Acceleration"][:, :, None] + np.cross(al, d, axis=1) + np.cross(w, wd, axis=1)
+    wd = _cross(w, d)
+    A = data["Acceleration"][:, :, None] + _cross(al, d) + _cross(w, wd)
     return P, A
+
+
+def _cross(a, b):
+    """Cross product along axis 1 of (n, 3, 1) and (n, 3, m) arrays."""
+    a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
+    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=1)
 
 
 def _small_rotation(R, R0):
@@ -296,6 +303,11 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
              y_offset: float = 0.0, seed: int | None = None, frame_segments: int | None = None,
              newton: bool | None = None) -> SimResult:
     """Simulate a vehicle driving over a road.
+
+    The linear model (no nonlinear effect) is integrated with one linear solve per
+    step; should that fail or diverge (motions so large that the geometric
+    nonlinearity matters, e.g. a very rough road), the run is repeated with Newton
+    iterations (``meta["newton_fallback"] = True``) before an error is raised.
 
     Parameters
     ----------
@@ -343,6 +355,26 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
         The solver failed or diverged; the message names the simulated time and the
         likely cause.
     """
+    kw = dict(chassis=chassis, effects=effects, dt=dt, fs_out=fs_out, x_start=x_start,
+              y_offset=y_offset, seed=seed, frame_segments=frame_segments)
+    wall0, cpu0 = _time.perf_counter(), _time.process_time()
+    try:
+        return _simulate(vehicle, road, speed, duration, newton=newton, **kw)
+    except SimulationError as first:
+        if newton is not None or getattr(first, "newton", True):
+            raise
+    res = _simulate(vehicle, road, speed, duration, newton=True, **kw)
+    res.meta["newton_fallback"] = True
+    res.meta["wall_s"] = _time.perf_counter() - wall0
+    res.meta["cpu_s"] = _time.process_time() - cpu0
+    res.meta["realtime_factor"] = res.meta["duration"] / res.meta["wall_s"]
+    res.meta["cpu_realtime_factor"] = res.meta["duration"] / res.meta["cpu_s"]
+    return res
+
+
+def _simulate(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_start, y_offset,
+              seed, frame_segments, newton) -> SimResult:
+    """One attempt of :func:`simulate` (``newton`` None: only for nonlinear effects)."""
     wall0 = _time.perf_counter()
     cpu0 = _time.process_time()
     exu = __import__("exudyn")
@@ -387,7 +419,7 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
 
     # ---- road coverage (refuse before simulating)
     xs_axle = np.array([a.x for a in vp.axles])
-    margin = 0.5 * eff["tyre_enveloping"]["length"] if "tyre_enveloping" in eff else 0.0
+    margin = 0.5 * ctx.notes.get("tyre_enveloping_length_m", 0.0)
     if x_start is None:
         x_start = road.x_min - xs_axle.min() + margin + 1e-9
     x_start = float(x_start)
@@ -484,10 +516,13 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     solve_cpu = _time.process_time() - solve_cpu0
     t_fail = float(solver.it.currentTime)
     if not ok:
-        raise SimulationError(_failure_message(t_fail, duration, eff, dt, err))
+        exc = SimulationError(_failure_message(t_fail, duration, eff, dt, err))
+        exc.newton = nonlinear
+        raise exc
     steps = int(solver.it.currentStepIndex) - 1
 
     # ---- outputs
+    out_cpu0 = _time.process_time()
     data = {b.name: _sensor_arrays(model, b.name, n_out) for b in model.bodies}
     # stored rows: the initial state and then every output period (possibly with
     # repeated times); take the last row stored at each output time
@@ -546,7 +581,11 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
         extra.update(_dcdc_reference(model, ref_model, data["dcdc"]))
     ordered["speed"] = profile.speed(time)
     channels = ordered
-    _check_divergence(channels, time, eff, dt, duration)
+    try:
+        _check_divergence(channels, time, eff, dt, duration)
+    except SimulationError as exc:
+        exc.newton = nonlinear
+        raise
 
     # tyre forces (dynamic part) and lift-off
     k_out = np.arange(n_out) * n_sub
@@ -564,6 +603,7 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     units = {n: unit_of(n) for n in channels}
     wall = _time.perf_counter() - wall0
     cpu = _time.process_time() - cpu0
+    out_cpu = _time.process_time() - out_cpu0
     meta = {
         "vehicle": vp0.id, "vehicle_name": vp0.name, "chassis": model.chassis,
         "frame_segments": len(model.segments) if model.chassis == "flexible" else 1,
@@ -572,7 +612,9 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
         "dt": dt, "fs_out": fs_out, "duration": duration, "steps": steps,
         "wall_s": wall, "solve_s": solve_s, "realtime_factor": duration / wall,
         "cpu_s": cpu, "solve_cpu_s": solve_cpu, "cpu_realtime_factor": duration / cpu,
+        "outputs_cpu_s": out_cpu, "prepare_cpu_s": cpu - solve_cpu - out_cpu,
         "n_dof": model.n_dof, "n_bodies": len(model.bodies), "newton": nonlinear,
+        "newton_fallback": False,
         "speed_mean": float(np.mean(profile.speed(time))), "distance_m": float(s_steps[-1]),
         "x_start": x_start, "y_offset": float(y_offset), "seed": seed,
         "tyre_lift_off_fraction": float(lift.mean()),

@@ -1,6 +1,8 @@
 """Effect ``bump_stop``: elastic stops that limit the compression travel."""
 from __future__ import annotations
 
+import math
+
 from vehicles.effects.base import Effect, Parameter
 
 
@@ -10,7 +12,7 @@ class BumpStop(Effect):
     name = "bump_stop"
     description = (
         "Bump stops: after a free compression travel 'gap' from static equilibrium a stiff "
-        "spring engages (smoothed over 'smoothing').  Inactive on smooth roads; on rough "
+        "spring engages (a softplus of width 'smoothing').  Inactive on smooth roads; on rough "
         "roads it clips the compression peaks of the suspension displacement and produces "
         "impacts: body accelerations get heavier tails (higher kurtosis and peaks) and more "
         "high-frequency content.")
@@ -18,7 +20,8 @@ class BumpStop(Effect):
         Parameter("gap", "m", 0.04, (0.005, 0.3),
                   "free compression travel from static equilibrium"),
         Parameter("stiffness", "N/m", 2.0e6, (1.0e4, 5.0e7), "contact stiffness"),
-        Parameter("smoothing", "m", 0.002, (1.0e-4, 0.02), "width of the smooth transition"),
+        Parameter("smoothing", "m", 0.002, (1.0e-4, 0.02),
+                  "width of the smooth transition (softplus scale)"),
     )
     primary = "gap"
     nonlinear = True
@@ -28,9 +31,11 @@ class BumpStop(Effect):
 
         esym = exudyn.symbolic
         g, k, s = p["gap"], p["stiffness"], p["smoothing"]
-        f0 = 0.5 * k * (-g + (g * g + s * s) ** 0.5)   # value at u = 0: keep statics exact
+        # k s softplus((u - g) / s): k (u - g) beyond the gap, exponentially small
+        # before it (k s e^(-g/s) at static equilibrium, subtracted to keep statics exact)
+        f0 = k * s * math.log1p(math.exp(-g / s))
 
         def term(u, v):
-            d = u - g
-            return 0.5 * k * (d + esym.sqrt(d * d + s * s)) - f0
+            x = (u - g) * (1.0 / s)
+            return k * s * (esym.max(x, 0.0) + esym.log(1.0 + esym.exp(-esym.abs(x)))) - f0
         return [term]

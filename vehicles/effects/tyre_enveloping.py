@@ -14,13 +14,16 @@ class TyreEnveloping(Effect):
         "zero is at the wavelength equal to the length.  Cuts the excitation above about "
         "v / (2 length) Hz: mainly axle accelerations above the axle-hop band.")
     parameters = (
-        Parameter("length", "m", 0.25, (0.02, 1.0),
-                  "footprint (contact) length; rounded to an odd number of road grid steps"),
+        Parameter("length", "m", 0.0, (0.0, 1.0),
+                  "footprint (contact) length, rounded to an odd number of road grid steps; "
+                  "0: the mean tyre_contact_length of the vehicle's axles"),
     )
     primary = "length"
     order = 20
 
     def road(self, road, p, ctx):
-        out = road.footprint_filtered(p["length"])
+        length = p["length"] or float(sum(a.tyre_contact_length for a in ctx.vp.axles)
+                                      / len(ctx.vp.axles))
+        out = road.footprint_filtered(length)
         ctx.notes["tyre_enveloping_length_m"] = float(out.meta.get("footprint_length", p["length"]))
         return out
