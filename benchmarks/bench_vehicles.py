@@ -84,6 +84,8 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--duration", type=float, default=30.0)
     ap.add_argument("--json", default=None, help="write the results to this JSON file")
+    ap.add_argument("--no-fast", action="store_true",
+                    help="skip the informative run with Exudyn's fast module (EXUDYN_MODULE=fast)")
     args = ap.parse_args(argv)
     duration = 10.0 if args.quick else args.duration
     repeat = 1 if args.quick else args.repeat
@@ -143,6 +145,36 @@ def main(argv=None) -> int:
         for g, v in acc.items():
             print(f"    {g:10s} rms {100 * v['rms_err']:6.3f} %  wave {100 * v['wave_err']:6.3f} %  "
                   f"(worst {v['worst']})")
+    if not args.no_fast and os.environ.get("EXUDYN_MODULE", "") != "fast":
+        # informative: Exudyn's build without range checks (opt-in through the
+        # environment, exudyn/__init__.py); same code, separate process
+        import subprocess
+        import sys
+
+        env = dict(os.environ, EXUDYN_MODULE="fast")
+        cmd = [sys.executable, "-c",
+               "import json, os, sys\n"
+               "sys.path.insert(0, os.getcwd())\n"
+               "from vehicles.simulate import simulate\n"
+               f"sys.path.insert(0, {os.path.dirname(os.path.abspath(__file__))!r})\n"
+               "from bench_vehicles import make_road\n"
+               f"road = make_road({duration * speed + 20.0})\n"
+               "out = {}\n"
+               "for ch in ('rigid', 'flexible'):\n"
+               "    simulate('dump_truck_8x4', road, 10.0, 2.0, chassis=ch)\n"
+               f"    r = [simulate('dump_truck_8x4', road, 10.0, {duration}, chassis=ch) for _ in range({repeat})]\n"
+               "    out[ch] = [max(x.meta['realtime_factor'] for x in r), max(x.meta['cpu_realtime_factor'] for x in r)]\n"
+               "print(json.dumps(out))\n"]
+        try:
+            proc = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600,
+                                  cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+            fast = json.loads(proc.stdout.strip().splitlines()[-1])
+            results["exudyn_fast_module"] = fast
+            print("\nwith EXUDYN_MODULE=fast (Exudyn without range checks, opt-in):")
+            for ch, (w, c) in fast.items():
+                print(f"  dump_truck_8x4/{ch}: {w:7.1f}x wall, {c:7.1f}x CPU")
+        except (subprocess.SubprocessError, ValueError, IndexError) as exc:  # pragma: no cover
+            print(f"\n(fast-module run skipped: {exc})")
     results["machine"]["loadavg_end"] = os.getloadavg()
     if args.json:
         with open(args.json, "w") as fh:

@@ -26,6 +26,7 @@ COMMAND_MODULES = (
     "drives.cli",
     "inverse.cli",
     "studies.cli",
+    "studies.cli_pantograph",
     "diagnosis.cli",
 )
 

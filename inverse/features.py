@@ -64,12 +64,13 @@ _R1, _R2 = 0.444, 0.028
 
 
 def third_octave_bands(f_lo: float = 0.5, f_hi: float = 50.0):
-    """Base-10 third-octave bands whose centres lie in [f_lo, f_hi].
+    """Base-10 third-octave bands whose nominal centres lie in [f_lo, f_hi].
 
     Parameters
     ----------
     f_lo, f_hi : float
-        Range of band centres [Hz].
+        Range of nominal band centres [Hz] (the exact centre 10^(k/10) of the
+        nominal 50 Hz band is 50.12 Hz; k = round(10 log10 f)).
 
     Returns
     -------
@@ -78,7 +79,7 @@ def third_octave_bands(f_lo: float = 0.5, f_hi: float = 50.0):
     """
     if not (0 < f_lo < f_hi):
         raise EroadInputError(f"third_octave_bands: need 0 < f_lo < f_hi, got {f_lo}, {f_hi}")
-    k = np.arange(math.ceil(10 * math.log10(f_lo) - 1e-9), math.floor(10 * math.log10(f_hi) + 1e-9) + 1)
+    k = np.arange(round(10 * math.log10(f_lo)), round(10 * math.log10(f_hi)) + 1)
     c = 10.0 ** (k / 10.0)
     return c, c * 10 ** (-0.05), c * 10 ** 0.05
 
@@ -341,9 +342,10 @@ class FeatureSet:
         if missing:
             raise EroadInputError(f"features: channels missing from the data: {', '.join(missing)}")
         fs = 1.0 / float(np.mean(np.diff(t)))
-        if spec.f_hi >= 0.5 * fs * 10 ** (-0.05):
-            raise EroadInputError(f"features: f_hi {spec.f_hi} Hz is too close to the Nyquist {fs / 2} Hz")
         centres, lower, upper = third_octave_bands(spec.f_lo, spec.f_hi)
+        if upper[-1] >= 0.5 * fs:
+            raise EroadInputError(f"features: the top band reaches {upper[-1]:.1f} Hz, above the Nyquist "
+                                  f"frequency {fs / 2} Hz; lower f_hi")
         noise = {}
         for c in spec.channels:
             if noise_psd is not None and c in noise_psd:
@@ -453,8 +455,10 @@ class FeatureSet:
         Returns
         -------
         ndarray, shape (K,)
-            sum_j weight_j (y_j - f_j)^2 [-]; about the number of features when
-            the model fits within the statistical scatter.
+            sum_j weight_j (y_j - f_j)^2 [-]; when the model fits within the
+            statistical scatter, about the number of features divided by the
+            channels per wheel station (with ``station_weighting``), i.e. about
+            the number of independent features.
         """
         return np.array([float(np.sum(wf.weight * (wf.y - f) ** 2)) for wf, f in zip(self.windows, feats)])
 

@@ -63,10 +63,12 @@ __all__ = [
     "save_figure11",
     "load_figure11",
     "plot_figure11",
+    "smoothing_kernel",
     "smoothed_power",
     "evaluate_findings",
     "findings_markdown",
     "write_findings",
+    "run_figure11",
 ]
 
 #: the vehicle of the pantograph studies
@@ -450,21 +452,29 @@ def drive_base_motion(vp, road, *, speed: float, duration: float, chassis: str =
 # modes
 # ---------------------------------------------------------------------------
 def mode_table(vp, chassis: str = "flexible", frame_factor: float = 1.0,
-               f_max: float = 100.0) -> list[dict]:
-    """Labelled modes of the configuration (``vehicles.modal``) with their base gains.
+               f_max: float = 100.0, speed: float | None = None,
+               freqs: np.ndarray | None = None) -> tuple[list[dict], dict | None]:
+    """Labelled modes of the configuration (``vehicles.modal``) and their contributions.
 
-    Besides the label and frequency, every mode gets the **peak gain** of each base
-    motion component ``c`` (Ty, Tz, Rx, Ry of the DCDC top-face centre, the linear
-    model's ``dcdc_<c>`` outputs), the modal approximation of the frequency response at
-    resonance for road input under all tyres::
+    The modal contributions decompose the linear response of each base motion
+    component (Ty, Tz, Rx, Ry of the DCDC top-face centre: the linear model's
+    ``dcdc_<c>`` outputs) to road input exactly into modes.  With the undamped,
+    mass-normalised modes ``Phi`` (all of them, so the transformation is exact) the
+    linearised system in modal coordinates is
+    ``Phi^T (K + j w D - w^2 M) Phi eta = Phi^T B(w) u`` and the response is
+    ``y = sum_j y_j``, ``y_j = (C phi_j) eta_j``.  The road input ``u`` is the left
+    and right track, taken as independent with equal spectra (an isotropic road:
+    tracks 1.9 m apart are incoherent above ~5 Hz at 10 m/s); every tyre sees its
+    track delayed by its distance behind the first axle (``B(w)`` sums
+    ``(Bk + j w Bc) exp(j w x_c / v)`` per side).  Tabulated is the size of each mode's
+    own contribution relative to the response::
 
-        gain_c = |C_c phi| * || phi^T (Bk + j w Bc) || / (2 zeta w^2)    [m/m, rad/m]
+        ratio_j = sqrt(sum_tracks |y_j|^2 / sum_tracks |y|^2)
 
-    with ``phi`` the mass-normalised undamped mode shape matched to the labelled mode,
-    ``w`` its circular frequency and ``zeta`` its damping ratio.  The 2-norm over the
-    tyres is the response of independent tyre inputs of equal spectrum (road tracks
-    are incoherent above ~2 Hz at 10 m/s; wheelbase delays are ignored).  It ranks
-    which mode dominates a quantity at a frequency (:func:`dominant_mode`).
+    A mode resonating at a response peak has a ratio of order 1 there; far from
+    their resonances, the quasi-static parts of the low modes can be large and
+    cancel each other (ratios above 1), which is why :func:`dominant_mode` looks only
+    at modes near the peak.
 
     Parameters
     ----------
@@ -473,12 +483,19 @@ def mode_table(vp, chassis: str = "flexible", frame_factor: float = 1.0,
     frame_factor : float, optional
     f_max : float, optional
         Highest natural frequency listed [Hz].
+    speed : float, optional
+        Vehicle speed [m/s] for the contributions (default: no contributions).
+    freqs : numpy.ndarray, optional
+        Frequencies of the contributions [Hz] (default 0.1 to 40 Hz every 0.1 Hz).
 
     Returns
     -------
-    list of dict
-        ``{label, freq_hz, damping, freq_damped_hz, freq_undamped_hz, gain: {Ty, Tz,
-        Rx, Ry}}``, ascending in ``freq_hz``.
+    (list of dict, dict or None)
+        Modes ``{label, freq_hz, damping, freq_damped_hz, freq_undamped_hz}``,
+        ascending; contributions ``{"f": (nf,), "ratio": (nf, n_modes, 4),
+        "components": ["Ty", "Tz", "Rx", "Ry"], "labels": [...], "freq_hz": [...]}``
+        with modes above ``f_max`` (quasi-rigid joints, guides) pooled into one entry
+        ``"stiff modes (> f_max)"``; None without ``speed``.
     """
     import scipy.linalg
 
@@ -487,21 +504,40 @@ def mode_table(vp, chassis: str = "flexible", frame_factor: float = 1.0,
     res = modal_analysis(vp, chassis=chassis,
                          stiffness_factor=float(frame_factor) if chassis == "flexible" else 1.0,
                          f_max=f_max)
+    table = res.table()
+    if speed is None:
+        return table, None
     lm = res.linear
     w2, phi = scipy.linalg.eigh(0.5 * (lm.K + lm.K.T), lm.M)
     f_und = np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi)
-    rows = {c: lm.output(f"dcdc_{c}").row for c in COMPONENTS}
-    out = []
+    # label every undamped mode by the labelled mode that matched it (freq_undamped_hz)
+    labels = [f"stiff modes (> {f_max:g} Hz)"] * len(f_und)
+    freq_of = [float("nan")] * len(f_und)
     for m in res.modes:
         j = int(np.argmin(np.abs(f_und - m.freq_undamped_hz)))
-        ph = phi[:, j]
-        w = 2 * np.pi * f_und[j]
-        zeta = max(float(m.damping), 1e-6)
-        drive = float(np.linalg.norm(ph @ (lm.Bk + 1j * w * lm.Bc)))
-        gains = {c: float(abs(rows[c] @ ph) * drive / (2 * zeta * w * w)) if w > 0 else 0.0
-                 for c in COMPONENTS}
-        out.append({**m.to_dict(), "gain": gains})
-    return out
+        labels[j], freq_of[j] = m.label, float(m.freq_hz)
+    groups = sorted(set(labels), key=lambda g: (g.startswith("stiff"), labels.index(g)))
+    gidx = np.array([groups.index(g) for g in labels])
+    f = np.arange(1, 401) * 0.1 if freqs is None else np.asarray(freqs, float)
+    c_phi = np.array([lm.output(f"dcdc_{c}").row for c in COMPONENTS]) @ phi     # (4, n)
+    k_m, d_m, m_m = phi.T @ lm.K @ phi, phi.T @ lm.D @ phi, phi.T @ lm.M @ phi
+    xs = np.array([c["x"] for c in lm.contacts])
+    left = np.array([c["side"] == "L" for c in lm.contacts])
+    power = np.zeros((f.size, len(groups), len(COMPONENTS)))
+    for i, fi in enumerate(f):
+        w = 2 * np.pi * fi
+        bw = (lm.Bk + 1j * w * lm.Bc) * np.exp(1j * w * xs / float(speed))[None, :]
+        bt = np.column_stack([bw[:, left].sum(axis=1), bw[:, ~left].sum(axis=1)])   # (n, 2)
+        eta = np.linalg.solve(k_m + 1j * w * d_m - w * w * m_m, phi.T @ bt)         # (n, 2)
+        yj = c_phi[:, :, None] * eta[None, :, :]                                   # (4, n, 2)
+        yg = np.zeros((len(COMPONENTS), len(groups), 2), complex)
+        np.add.at(yg, (slice(None), gidx), yj)        # modes of one group (stiff) add up
+        den = np.sum(np.abs(yj.sum(axis=1)) ** 2, axis=1)                          # (4,)
+        power[i] = (np.sum(np.abs(yg) ** 2, axis=2) / np.where(den > 0, den, np.inf)[:, None]).T
+    gfreq = [next((freq_of[j] for j in range(len(labels)) if labels[j] == g), float("nan"))
+             for g in groups]
+    return table, {"f": f, "ratio": np.sqrt(power), "components": list(COMPONENTS),
+                   "labels": groups, "freq_hz": gfreq, "speed_mps": float(speed)}
 
 
 def nearest_mode(freq: float, modes: list[dict]) -> dict | None:
@@ -527,42 +563,49 @@ def nearest_mode(freq: float, modes: list[dict]) -> dict | None:
             "delta_hz": round(float(freq - m["freq_hz"]), 4)}
 
 
-def dominant_mode(freq: float, component: str, modes: list[dict]) -> dict | None:
-    """The mode that contributes most to a base motion component at ``freq``.
+def dominant_mode(freq: float, component: str, contributions: dict | None,
+                  window: float = 0.25, min_ratio: float = 0.25) -> dict | None:
+    """The resonant mode that makes a response peak of a base motion component.
 
-    Contribution of mode j (single-degree-of-freedom approximation around its gain
-    of :func:`mode_table`), ``r = freq / f_j``::
-
-        c_j = gain_j * 2 zeta_j / |1 - r^2 + 2 j zeta_j r|
+    Among the modes whose natural frequency lies within ``window`` (relative, at
+    least 0.5 Hz) of ``freq``, the one with the largest own contribution
+    ``ratio_j`` (:func:`mode_table`) at ``freq``, if that is at least ``min_ratio``.
 
     Parameters
     ----------
     freq : float
-        [Hz]
+        Peak frequency [Hz].
     component : {"Ty", "Tz", "Rx", "Ry"}
-    modes : list of dict
-        From :func:`mode_table` (with ``gain``).
+    contributions : dict or None
+        From :func:`mode_table` (the nearest tabulated frequency is used).
+    window : float, optional
+        Relative half-width of the search (default 0.25).
+    min_ratio : float, optional
+        Smallest ratio that counts as making the peak (default 0.25).
 
     Returns
     -------
     dict or None
-        ``{label, freq_hz, damping, share}`` with ``share = c_j^2 / sum_k c_k^2`` (the
-        mode's part of the response power if the modes add incoherently), or None
-        without gains.
+        ``{label, freq_hz, ratio}`` (ratio = |own contribution| / |response|); label
+        None without a mode near ``freq`` that reaches ``min_ratio`` (the peak is then
+        not a resonance:
+        quasi-static response, or the road's and the wheelbase's spectral shape); None
+        without contributions.
     """
-    mm = [m for m in modes if isinstance(m.get("gain"), dict) and component in m["gain"]]
-    if not mm or not np.isfinite(freq):
+    if not contributions or not np.isfinite(freq):
         return None
-    c = []
-    for m in mm:
-        r = freq / m["freq_hz"]
-        z = max(m["damping"], 1e-6)
-        c.append(m["gain"][component] * 2 * z / abs(1 - r * r + 2j * z * r))
-    c = np.asarray(c)
-    j = int(np.argmax(c))
-    tot = float(np.sum(c ** 2))
-    return {"label": mm[j]["label"], "freq_hz": mm[j]["freq_hz"], "damping": mm[j]["damping"],
-            "share": round(float(c[j] ** 2 / tot), 4) if tot > 0 else float("nan")}
+    f = np.asarray(contributions["f"])
+    i = int(np.argmin(np.abs(f - freq)))
+    c = list(contributions["components"]).index(component)
+    r = np.asarray(contributions["ratio"])[i, :, c]
+    fm = np.asarray(contributions["freq_hz"], float)
+    half = max(window * freq, 0.5)
+    near = np.isfinite(fm) & (np.abs(fm - freq) <= half)
+    j = int(np.flatnonzero(near)[np.argmax(r[near])]) if near.any() else -1
+    if j < 0 or r[j] < min_ratio:
+        return {"label": None, "freq_hz": float("nan"), "ratio": float("nan")}
+    return {"label": str(contributions["labels"][j]), "freq_hz": float(fm[j]),
+            "ratio": round(float(r[j]), 4)}
 
 
 # ---------------------------------------------------------------------------
@@ -587,6 +630,8 @@ class Figure11Data:
         [rad, rad/s, rad/s^2, m, m/s, m/s^2] (Hann, peak-reading).
     modes : list of dict
         Mode table of the configuration (:func:`mode_table`).
+    contributions : dict or None
+        Modal contributions to Ty, Tz, Rx, Ry over frequency (:func:`mode_table`).
     check : dict or None
         :func:`kinematics_check` of the same drive.
     meta : dict
@@ -599,6 +644,7 @@ class Figure11Data:
     f: np.ndarray
     spectra: dict
     modes: list = field(default_factory=list)
+    contributions: dict | None = None
     check: dict | None = None
     meta: dict = field(default_factory=dict)
 
@@ -649,7 +695,7 @@ def compute_figure11(road, *, vehicle: Any = DEFAULT_VEHICLE, speed: float = 10.
     f = None
     for name, (comp, order, _, _) in QUANTITIES.items():
         f, spectra[name] = amplitude_spectrum(getattr(m, comp), d["fs"], order=order)
-    modes = mode_table(vp, chassis, frame_factor)
+    modes, contrib = mode_table(vp, chassis, frame_factor, speed=speed)
     meta = {"vehicle": vp.id, "chassis": chassis, "frame_factor": float(frame_factor),
             "mount_factor": float(mount_factor), "speed_mps": float(speed),
             "duration_s": float(dur), "t_skip_s": float(t_skip), "fs_hz": d["fs"],
@@ -660,8 +706,8 @@ def compute_figure11(road, *, vehicle: Any = DEFAULT_VEHICLE, speed: float = 10.
                      if isinstance(v, (int, float, str, bool))},
             "road_length_m": float(road.length)}
     return Figure11Data(time=m.time, motion={c: getattr(m, c) for c in COMPONENTS},
-                        fs=d["fs"], f=f, spectra=spectra, modes=modes, check=d["check"],
-                        meta=meta)
+                        fs=d["fs"], f=f, spectra=spectra, modes=modes, contributions=contrib,
+                        check=d["check"], meta=meta)
 
 
 def save_figure11(data: Figure11Data, folder: str | Path) -> dict[str, Path]:
@@ -669,8 +715,9 @@ def save_figure11(data: Figure11Data, folder: str | Path) -> dict[str, Path]:
 
     Files: ``figure11_spectra.npz`` (f, every spectrum, time, motion, fs),
     ``figure11_spectra.csv`` (f and the 12 spectra, unit in each header),
-    ``base_motion.csv`` (time, Ty, Tz, Rx, Ry), ``modes.json``, ``figure11_meta.json``
-    and ``kinematics_check.json`` (if checked).
+    ``base_motion.csv`` (time, Ty, Tz, Rx, Ry), ``modes.json``,
+    ``modal_contributions.npz``, ``figure11_meta.json`` and ``kinematics_check.json``
+    (if checked).
 
     Parameters
     ----------
@@ -704,6 +751,12 @@ def save_figure11(data: Figure11Data, folder: str | Path) -> dict[str, Path]:
     out["motion"] = folder / "base_motion.csv"
     pd.DataFrame(motion).to_csv(out["motion"], index=False, float_format="%.9e")
     out["modes"] = write_json_atomic(folder / "modes.json", data.modes)
+    if data.contributions is not None:
+        c = data.contributions
+        out["contributions"] = folder / "modal_contributions.npz"
+        np.savez(out["contributions"], f=c["f"], ratio=np.asarray(c["ratio"], np.float32),
+                 components=np.array(c["components"]), labels=np.array(c["labels"]),
+                 freq_hz=np.array(c["freq_hz"]), speed_mps=np.array(c["speed_mps"]))
     out["meta"] = write_json_atomic(folder / "figure11_meta.json", data.meta)
     if data.check is not None:
         out["check"] = write_json_atomic(folder / "kinematics_check.json", data.check)
@@ -741,6 +794,14 @@ def load_figure11(folder: str | Path) -> Figure11Data:
         return json.loads(p.read_text()) if p.is_file() else None
 
     data.modes = read("modes.json") or []
+    pc = folder / "modal_contributions.npz"
+    if pc.is_file():
+        with np.load(pc, allow_pickle=False) as z:
+            data.contributions = {"f": z["f"], "ratio": z["ratio"].astype(float),
+                                  "components": [str(x) for x in z["components"]],
+                                  "labels": [str(x) for x in z["labels"]],
+                                  "freq_hz": [float(x) for x in z["freq_hz"]],
+                                  "speed_mps": float(z["speed_mps"])}
     data.check = read("kinematics_check.json")
     data.meta = read("figure11_meta.json") or {}
     return data
@@ -784,11 +845,8 @@ def plot_figure11(data: Figure11Data | str | Path, path: str | Path, *, f_max: f
         data = load_figure11(data)
     f = data.f
     sel = (f > 0) & (f <= f_max)
-    # smoothed amplitude: sqrt(2 ENBW P_s) with P_s the power averaged over SMOOTH_HZ
-    # (the same smoothing as the findings); Hann ENBW = 1.5 bins
-    n_avg = max(1, int(round(SMOOTH_HZ / (f[1] - f[0]))))
-    n_avg += 1 - n_avg % 2
-    kernel = np.ones(n_avg) / n_avg
+    # smoothed amplitude: the root of the amplitude^2 smoothed like the findings' power
+    kernel = smoothing_kernel(f[1] - f[0])
     smooth = {k: np.sqrt(np.convolve(a ** 2, kernel, mode="same")) for k, a in data.spectra.items()}
     col_titles = ("angle / displacement", "velocity", "acceleration")
     fig, axes = plt.subplots(4, 3, figsize=(13, 11), sharex=True)
@@ -847,7 +905,7 @@ def plot_figure11(data: Figure11Data | str | Path, path: str | Path, *, f_max: f
 # findings
 # ---------------------------------------------------------------------------
 #: the paper's findings and the criterion each is judged by (P = power spectrum, mean
-#: square per bin; P_s = P averaged over SMOOTH_HZ; f_peak(q) = frequency of the largest
+#: square per bin; P_s = P smoothed over SMOOTH_HZ; f_peak(q) = frequency of the largest
 #: P_s of quantity q in (0, F_MAX]; E_q(band) = sum of P over the band).  See
 #: docs/pantograph.md for why each threshold has its value.
 CRITERIA = {
@@ -867,9 +925,9 @@ CRITERIA = {
           "E_Ty_acc(20 Hz-F_MAX) / E_Ty_acc(0-F_MAX) >= 0.5 (lateral acceleration; the "
           "shares of displacement and velocity are reported too)"),
 }
-#: smoothing width of the peak search [Hz] (Daniell: moving average of the power).  Over
-#: a 29 s record 1 Hz averages 29 bins: ~58 degrees of freedom, a standard deviation of
-#: 0.08 in log10 P_s for a random-road response
+#: equivalent smoothing width of the peak search [Hz] (Hann-weighted average of the
+#: power, :func:`smoothing_kernel`).  Over a 29 s record it averages ~29 bins: ~58
+#: degrees of freedom, a standard deviation of 0.08 in log10 P_s for a random-road response
 SMOOTH_HZ = 1.0
 #: prominence of a peak in log10 P_s [decades] for finding (c): 0.5 is ~4.5 standard
 #: deviations of the difference of two smoothed log values (random peaks are rare)
@@ -896,9 +954,9 @@ class Finding:
         The numbers the criterion was evaluated on.
     peaks : list of dict
         Peaks involved: ``{quantity, freq_hz, mode, dominant}``: the nearest mode
-        ``{label, freq_hz, damping, delta_hz}`` (:func:`nearest_mode`) and the mode
-        contributing most to the quantity there ``{label, freq_hz, damping, share}``
-        (:func:`dominant_mode`).
+        ``{label, freq_hz, damping, delta_hz}`` (:func:`nearest_mode`) and the
+        resonant mode making the peak ``{label, freq_hz, ratio}``
+        (:func:`dominant_mode`, None if no mode is near).
     explanation : str
         One-line physical reading.
     """
@@ -918,9 +976,35 @@ class Finding:
                 "explanation": self.explanation}
 
 
+def smoothing_kernel(df: float, smooth_hz: float = SMOOTH_HZ) -> np.ndarray:
+    """Hann-shaped frequency smoothing kernel of equivalent width ``smooth_hz``.
+
+    A Hann kernel of n points averages ``(sum w)^2 / sum w^2 = n / 1.5`` bins
+    effectively, so ``n = 1.5 smooth_hz / df`` (odd) gives the variance reduction of a
+    ``smooth_hz`` wide moving average, with a single maximum on a spectral line (a
+    boxcar would leave a flat top ``smooth_hz`` wide and an uncertain peak frequency).
+
+    Parameters
+    ----------
+    df : float
+        Bin spacing [Hz].
+    smooth_hz : float, optional
+        Equivalent width [Hz].
+
+    Returns
+    -------
+    numpy.ndarray
+        Kernel weights (sum 1), odd length >= 1.
+    """
+    n = max(1, int(round(1.5 * smooth_hz / df)))
+    n += 1 - n % 2
+    w = np.hanning(n + 2)[1:-1]
+    return w / w.sum()
+
+
 def smoothed_power(x: np.ndarray, fs: float, order: int = 0,
                    smooth_hz: float = SMOOTH_HZ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Power spectrum and its moving average over ``smooth_hz`` (for peak search).
+    """Power spectrum and its smoothed version (for the peak search of the findings).
 
     Parameters
     ----------
@@ -931,19 +1015,16 @@ def smoothed_power(x: np.ndarray, fs: float, order: int = 0,
     order : int, optional
         Time-derivative order.
     smooth_hz : float, optional
-        Width of the moving average [Hz] (odd number of bins, at least 1).
+        Equivalent width of the smoothing [Hz] (:func:`smoothing_kernel`).
 
     Returns
     -------
     (f, P, P_s)
-        Frequencies [Hz], mean square per bin and its smoothed version
-        [U^2 / s^(2 order)].
+        Frequencies [Hz], mean square per bin (:func:`studies.pantograph.power_spectrum`)
+        and its smoothed version [U^2 / s^(2 order)].
     """
     f, p = power_spectrum(x, fs, order=order)
-    df = f[1] - f[0]
-    n = max(1, int(round(smooth_hz / df)))
-    n += 1 - n % 2
-    ps = np.convolve(p, np.ones(n) / n, mode="same")
+    ps = np.convolve(p, smoothing_kernel(f[1] - f[0], smooth_hz), mode="same")
     return f, p, ps
 
 
@@ -957,7 +1038,8 @@ def _band(f, p, lo, hi) -> float:
 
 
 def evaluate_findings(motion: Mapping[str, np.ndarray], fs: float, modes: list[dict] | None = None,
-                      f_max: float = F_MAX, smooth_hz: float = SMOOTH_HZ,
+                      contributions: dict | None = None, f_max: float = F_MAX,
+                      smooth_hz: float = SMOOTH_HZ,
                       prominence: float = PEAK_PROMINENCE) -> list[Finding]:
     """Judge the paper's five Figure-11 findings for a base motion.
 
@@ -968,7 +1050,9 @@ def evaluate_findings(motion: Mapping[str, np.ndarray], fs: float, modes: list[d
     fs : float
         Sample rate [Hz].
     modes : list of dict, optional
-        Mode table (:func:`mode_table`) for the peak explanations.
+        Mode table (:func:`mode_table`) for the peak explanations (nearest mode).
+    contributions : dict, optional
+        Modal contributions (:func:`mode_table`) for the dominant mode at each peak.
     f_max : float, optional
         Upper analysis frequency [Hz] (default 40).
     smooth_hz : float, optional
@@ -994,7 +1078,7 @@ def evaluate_findings(motion: Mapping[str, np.ndarray], fs: float, modes: list[d
 
     def peak_entry(name, freq):
         return {"quantity": name, "freq_hz": round(freq, 4), "mode": nearest_mode(freq, modes),
-                "dominant": dominant_mode(freq, QUANTITIES[name][0], modes)}
+                "dominant": dominant_mode(freq, QUANTITIES[name][0], contributions)}
 
     out = []
     # (a) pitch dominates below 0.5 Hz
@@ -1096,14 +1180,16 @@ def findings_markdown(findings: list[Finding], meta: dict | None = None) -> str:
                      f"x{meta.get('mount_factor')}, {meta.get('speed_mps')} m/s, "
                      f"{meta.get('duration_s', 0) - meta.get('t_skip_s', 0):.1f} s analysed.")
         lines.append("")
-    lines.append(f"P = power spectrum (mean square per bin), P_s = P averaged over "
-                 f"{SMOOTH_HZ:g} Hz, f_peak = frequency of the largest P_s in (0, {F_MAX:g}] Hz, "
+    lines.append(f"P = power spectrum (mean square per bin), P_s = P smoothed over "
+                 f"{SMOOTH_HZ:g} Hz (Hann-weighted), f_peak = frequency of the largest P_s in (0, {F_MAX:g}] Hz, "
                  "E = band mean square; `X_max_6_10Hz_over_max` = largest P_s in 6-10 Hz / "
                  "largest P_s (1 when the peak is in the band).")
     lines.append("")
-    lines.append("Modes: *nearest* = nearest natural frequency; *dominant* = largest modal "
-                 "contribution to the quantity at the peak frequency (share of the response "
-                 "power, modes added incoherently).")
+    lines.append("Modes: *nearest* = nearest natural frequency; *resonant* = among the modes "
+                 "within 25 % (>= 0.5 Hz) of the peak, the one with the largest own "
+                 "contribution to the quantity's linear response there, if >= 0.25 (ratio = "
+                 "|mode's contribution| / |response|; exact modal decomposition, independent "
+                 "left/right tracks with wheelbase delays).")
     lines.append("")
     lines.append("| | paper's finding | for our model | criterion | values | modes at the peaks |")
     lines.append("|---|---|---|---|---|---|")
@@ -1120,8 +1206,10 @@ def findings_markdown(findings: list[Finding], meta: dict | None = None) -> str:
         mods = "; ".join(
             f"{p['quantity']} {p['freq_hz']:.2f} Hz: nearest {p['mode']['label']} "
             f"{p['mode']['freq_hz']:.2f} Hz"
-            + (f", dominant {p['dominant']['label']} {p['dominant']['freq_hz']:.2f} Hz "
-               f"({100 * p['dominant']['share']:.0f} %)" if p.get("dominant") else "")
+            + ("" if not p.get("dominant") else
+               f", resonant {p['dominant']['label']} {p['dominant']['freq_hz']:.2f} Hz "
+               f"(ratio {p['dominant']['ratio']:.2f})" if p["dominant"]["label"]
+               else ", no resonance near (quasi-static / spectral shape)")
             for p in fd.peaks if p.get("mode"))
         lines.append(f"| ({fd.id}) | {fd.claim} | **{'true' if fd.holds else 'false'}** | "
                      f"{fd.criterion} | {vals} | {mods or '-'} |")
@@ -1155,3 +1243,85 @@ def write_findings(findings: list[Finding], folder: str | Path, meta: dict | Non
     tmp.write_text(findings_markdown(findings, meta), encoding="utf-8")
     tmp.replace(pm)
     return pj, pm
+
+
+# ---------------------------------------------------------------------------
+# the archived study
+# ---------------------------------------------------------------------------
+#: study name (folder under the results root)
+STUDY = "figure11"
+
+
+def run_figure11(road_path: str | Path, out_root: str | Path = "results", *,
+                 vehicle: Any = DEFAULT_VEHICLE, speed: float = 10.0,
+                 duration: float | None = 30.0, chassis: str = "flexible",
+                 frame_factor: float = 1.0, mount_factor: float = 1.0, t_skip: float = 1.0,
+                 command: list[str] | None = None) -> dict:
+    """Figure 11, its findings and the kinematics check on a road file, archived.
+
+    Writes ``<out_root>/figure11/<run-id>/`` with ``data/`` (:func:`save_figure11`,
+    ``findings.json``, ``findings.md``), ``figures/figure11.png|pdf`` (drawn from the
+    saved data) and ``summary.json``.
+
+    Parameters
+    ----------
+    road_path : str or Path
+        Road file (``.npz`` / ``.crg``).
+    out_root : str or Path, optional
+        Results root.
+    vehicle, speed, duration, chassis, frame_factor, mount_factor, t_skip
+        As in :func:`compute_figure11`.
+    command : list of str, optional
+        Command line recorded in ``run.json`` (default ``sys.argv``).
+
+    Returns
+    -------
+    dict
+        The summary with ``path`` (the run folder).
+    """
+    from roadlib.surface import RoadSurface
+
+    from studies.runs import RunArchive
+
+    road_path = Path(road_path).resolve()
+    road = RoadSurface.load(road_path)
+    config = {"road_file": str(road_path), "vehicle": str(vehicle), "speed_mps": float(speed),
+              "duration_s": None if duration is None else float(duration), "chassis": chassis,
+              "frame_factor": float(frame_factor), "mount_factor": float(mount_factor),
+              "t_skip_s": float(t_skip), "method": "linear (paper eq. 9-11)",
+              "findings": {"smooth_hz": SMOOTH_HZ, "f_max_hz": F_MAX,
+                           "peak_prominence_decades": PEAK_PROMINENCE}}
+    with RunArchive(STUDY, config, root=out_root, command=command) as run:
+        data = compute_figure11(road, vehicle=vehicle, speed=speed, duration=duration,
+                                chassis=chassis, frame_factor=frame_factor,
+                                mount_factor=mount_factor, t_skip=t_skip)
+        save_figure11(data, run.data_dir)
+        saved = load_figure11(run.data_dir)          # findings and plot from the files
+        findings = evaluate_findings(saved.motion, saved.fs, saved.modes, saved.contributions)
+        write_findings(findings, run.data_dir, saved.meta)
+        figs = plot_figure11(saved, run.figures_dir / "figure11.png")
+        chk = saved.check or {}
+        summary = {
+            "study": STUDY, "vehicle": saved.meta.get("vehicle"), "chassis": chassis,
+            "frame_factor": float(frame_factor), "mount_factor": float(mount_factor),
+            "speed_mps": float(speed), "duration_s": saved.meta.get("duration_s"),
+            "cond_A": saved.meta.get("cond"),
+            "findings": {f.id: bool(f.holds) for f in findings},
+            "findings_claims": {f.id: f.claim for f in findings},
+            "kinematics_check": {
+                "cond": chk.get("cond"), "cond_exact_with_yaw": chk.get("cond_exact"),
+                "exact_max_rel_error": max(chk["exact"]["rel_error"][c] for c in COMPONENTS)
+                if chk else None,
+                "linear_max_rel_error": chk["linear"]["rel_error"] if chk else None,
+                "forward_max_abs_error_m": chk.get("forward_max_abs_error"),
+                "max_angle_rad": chk.get("max_angle_rad")},
+            "frame_modes_hz": {m["label"]: m["freq_hz"] for m in saved.modes
+                               if m["label"].startswith("frame")},
+            "dcdc_modes_hz": {m["label"]: m["freq_hz"] for m in saved.modes
+                              if m["label"].startswith("DCDC")},
+            "sim_wall_s": saved.meta.get("simulation", {}).get("wall_s"),
+            "figures": [str(p.relative_to(run.path)) for p in figs],
+        }
+        run.write_summary(summary)
+    summary["path"] = str(run.path)
+    return summary

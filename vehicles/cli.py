@@ -3,8 +3,7 @@
 What it is for: running one simulation from files (vehicle, road, speed) into a
 dataset folder in the measurement format plus ``summary.json``, and listing the
 effect library.  What it is not: the simulator (:mod:`vehicles.simulate`) or the
-modal analysis command (``eroad modes``, registered by :mod:`vehicles.modal` when it
-provides a ``register`` function).
+modal analysis command (``eroad modes``, :mod:`vehicles.cli_modes`).
 """
 from __future__ import annotations
 
@@ -16,7 +15,7 @@ from eroad.errors import EroadInputError
 
 
 def register(subparsers) -> None:
-    """Add ``simulate`` and ``effects`` (and ``modes`` if available) to the CLI."""
+    """Add ``simulate`` and ``effects`` to the CLI."""
     p = subparsers.add_parser(
         "simulate", help="drive a vehicle model over a road file and write a dataset",
         description="Simulate a vehicle (rigid or flexible chassis, optional effects) over a "
@@ -51,12 +50,6 @@ def register(subparsers) -> None:
     e.add_argument("--json", action="store_true", help="machine-readable list")
     e.set_defaults(func=cmd_effects)
 
-    try:  # the modal analysis lives in vehicles.modal (another module owns it)
-        from vehicles import modal
-    except ImportError:  # pragma: no cover
-        modal = None
-    if modal is not None and hasattr(modal, "register"):
-        modal.register(subparsers)
 
 
 def load_road(path):

@@ -62,6 +62,9 @@ class SimResult:
         tyre force change [N].
     vehicle : VehicleParams or None
         The (effect-modified) vehicle that was simulated.
+    nominal_vehicle : VehicleParams or None
+        The vehicle as given to ``simulate`` (before effects): the one a dataset
+        names as its nominal vehicle.
     """
 
     time: np.ndarray
@@ -70,6 +73,7 @@ class SimResult:
     meta: dict = field(default_factory=dict)
     extra: dict = field(default_factory=dict)
     vehicle: object = None
+    nominal_vehicle: object = None
 
     @property
     def sample_rate_hz(self) -> float:
@@ -112,8 +116,9 @@ class SimResult:
             Dataset name (default: the folder name).
         vehicle : str or Path, optional
             A built-in vehicle id (written to meta) or a vehicle TOML file (copied to
-            ``vehicle.toml``).  Default: the simulated vehicle's id if it is built in,
-            else its source file.
+            ``vehicle.toml``).  Default: the nominal vehicle (as given to
+            ``simulate``, before effects): its id if it equals the built-in vehicle,
+            otherwise its parameters written to ``vehicle.toml``.
         overwrite : bool
         description : str, optional
         add_files : callable, optional
@@ -126,17 +131,27 @@ class SimResult:
         Path
             The dataset folder.
         """
+        import tempfile
+
         from drives.format import write_drive
 
-        from vehicles.params import builtin_ids
+        from vehicles.params import builtin_ids, load_vehicle, save_vehicle
 
-        vfile = None
-        vid = vehicle if vehicle is not None else self.meta.get("vehicle")
-        if vehicle is None and self.vehicle is not None and self.vehicle.id not in builtin_ids():
-            vid = self.vehicle.source or None
-        if vid is not None and str(vid) not in builtin_ids():
-            vfile = Path(vid)
-            vid = None
+        vfile, vid, tmpdir = None, None, None
+        if vehicle is not None:
+            if str(vehicle) in builtin_ids():
+                vid = str(vehicle)
+            else:
+                vfile = Path(vehicle)
+        else:
+            nom = self.nominal_vehicle
+            if nom is not None and nom.id in builtin_ids() and nom == load_vehicle(nom.id):
+                vid = nom.id
+            elif nom is not None:   # a variant or a file: write its parameters
+                tmpdir = tempfile.TemporaryDirectory()
+                vfile = save_vehicle(nom, Path(tmpdir.name) / "vehicle.toml")
+            else:
+                vid = self.meta.get("vehicle")
         meta = {"name": name or Path(folder).name, "sample_rate_hz": self.sample_rate_hz}
         if vid is not None:
             meta["vehicle"] = str(vid)
@@ -147,8 +162,12 @@ class SimResult:
             f"effects {json.dumps(self.meta.get('effects', {}))}")
         if start_time_s is not None:
             meta["start_time_s"] = float(start_time_s)
-        return write_drive(folder, self.to_dataframe(), meta, vehicle_file=vfile,
-                           overwrite=overwrite, add_files=add_files)
+        try:
+            return write_drive(folder, self.to_dataframe(), meta, vehicle_file=vfile,
+                               overwrite=overwrite, add_files=add_files)
+        finally:
+            if tmpdir is not None:
+                tmpdir.cleanup()
 
     def summary(self) -> dict:
         """JSON-ready summary: timing, sizes and the RMS of every channel."""

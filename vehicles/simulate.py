@@ -6,11 +6,11 @@ a speed (constant or a :class:`SpeedProfile`), effects, and returns a
 simulator the virtual test drive, the inverse fit and the gap diagnosis call, many
 times, so it is built for speed:
 
-* the road height under every tyre is computed for the whole time grid at once
-  (vectorised bilinear interpolation), and turned into two road loads per axle
-  (vertical force and roll moment, see :mod:`vehicles.builder`);
-* one Python ``PreStep`` callback per step only indexes those arrays and sets the
-  loads; everything else runs in Exudyn's C++;
+* the road height and slope under every tyre are computed for the whole time grid
+  at once (bilinear interpolation, vectorised) and turned into the generalised road
+  forces on the axle nodes (see :mod:`vehicles.builder`);
+* one Python ``PreStep`` callback per step only indexes that array and sets the
+  road forces with one call; everything else runs in Exudyn's C++;
 * the linear model (no nonlinear effect) is integrated with the implicit
   generalized-alpha method as a linear implicit scheme (one solve per step with the
   Jacobian factorised once); nonlinear effects switch Newton iterations on;
@@ -240,7 +240,7 @@ def _static_point(model, body_name, world_point):
     return p0 + R0 @ (np.asarray(world_point) - b.cog)
 
 
-def _sensor_arrays(model, name, n):
+def _sensor_arrays(model, name):
     mbs = model.mbs
     out = {}
     for key, s in model.sensors[name].items():
@@ -249,15 +249,6 @@ def _sensor_arrays(model, name, n):
         out["t"] = d[:, 0]
     out["RotationMatrix"] = out["RotationMatrix"].reshape(-1, 3, 3)
     return out
-
-
-def _point_kinematics(data, local):
-    """World position and acceleration of a body-fixed point from node outputs."""
-    d = np.einsum("nij,j->ni", data["RotationMatrix"], local)
-    pos = data["Position"] + d
-    w, al = data["AngularVelocity"], data["AngularAcceleration"]
-    acc = data["Acceleration"] + np.cross(al, d) + np.cross(w, np.cross(w, d))
-    return pos, acc
 
 
 def _body_points(data, L):
@@ -377,7 +368,7 @@ def _simulate(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_st
     """One attempt of :func:`simulate` (``newton`` None: only for nonlinear effects)."""
     wall0 = _time.perf_counter()
     cpu0 = _time.process_time()
-    exu = __import__("exudyn")
+    import exudyn as exu
     vp0: VehicleParams = load_vehicle(vehicle)
     try:
         duration = float(duration)
@@ -523,7 +514,7 @@ def _simulate(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_st
 
     # ---- outputs
     out_cpu0 = _time.process_time()
-    data = {b.name: _sensor_arrays(model, b.name, n_out) for b in model.bodies}
+    data = {b.name: _sensor_arrays(model, b.name) for b in model.bodies}
     # stored rows: the initial state and then every output period (possibly with
     # repeated times); take the last row stored at each output time
     ts = data[model.segments[0].name]["t"]
@@ -622,14 +613,16 @@ def _simulate(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_st
                  if isinstance(v, (int, float, str, bool))},
         "exudyn_version": exu.__version__,
     }
-    return SimResult(time=time, channels=channels, units=units, meta=meta, extra=extra, vehicle=vp)
+    return SimResult(time=time, channels=channels, units=units, meta=meta, extra=extra, vehicle=vp,
+                     nominal_vehicle=vp0)
 
 
 def _dcdc_reference(model, ref_model, data) -> dict:
     d = model.vp.dcdc
     top = np.array([d.x, d.y, d.z_base + d.height])
     b = model.body("dcdc")
-    pos, acc = _point_kinematics(data, top - b.cog)
+    P, A = _body_points(data, (top - b.cog)[None, :])
+    pos, acc = P[:, :, 0], A[:, :, 0]
     p_ref = _static_point(ref_model, "dcdc", top)
     R0 = ref_model.static["dcdc"][1]
     rot = _small_rotation(data["RotationMatrix"], R0)

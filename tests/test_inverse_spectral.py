@@ -1,0 +1,45 @@
+"""Parameter layout, bounds, ISO classes and grid steps of the inverse fit.
+
+Reference: ISO 8608:2016 Table 1, geometric means of Gd(n0) per class
+(A 16e-6, B 64e-6, ..., H 262144e-6 m^3, a factor 4 per class; bounds a factor 2
+either side), as quoted in issue 2.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from eroad.errors import EroadInputError
+from inverse.spectral import (ISO_CLASS_GD0, ParamBounds, grid_spacing, iso_class, params_to_theta,
+                              theta_to_params)
+
+
+def test_iso_class_table():
+    assert ISO_CLASS_GD0["A"] == pytest.approx(16e-6)
+    assert ISO_CLASS_GD0["H"] == pytest.approx(262144e-6)
+    assert iso_class(256e-6) == "C"
+    assert iso_class(0.99 * 512e-6) == "C" and iso_class(1.01 * 512e-6) == "D"
+    with pytest.raises(EroadInputError):
+        iso_class(-1.0)
+
+
+def test_theta_round_trip():
+    p = np.array([[256e-6, 2.0, 0.05, 5.0], [1e-3, 1.6, 0.01, 3.0]])
+    np.testing.assert_allclose(theta_to_params(params_to_theta(p)), p, rtol=1e-14)
+    assert params_to_theta(p)[0, 0] == pytest.approx(math.log(256e-6))
+
+
+def test_bounds_nyquist_cap_and_projection():
+    b = ParamBounds().for_record(fs=200.0, v_max=11.28)
+    assert b.nmax[1] == pytest.approx(200.0 / (2 * 11.28))
+    th = b.clip_theta(params_to_theta([[1.0, 5.0, 0.19, 1.0]]))
+    p = theta_to_params(th)[0]
+    assert p[0] <= b.Gq_n0[1] * (1 + 1e-12) and p[1] == 3.0
+    assert p[3] / p[2] >= b.min_ratio * (1 - 1e-12)
+
+
+def test_grid_spacing():
+    """dx = largest nice step <= 1 / (4 nmax): nmax 5 -> 0.05 m, 8.87 -> 0.025 m."""
+    assert grid_spacing(5.0) == 0.05
+    assert grid_spacing(8.87) == 0.025
+    assert grid_spacing(2.0) == 0.125
