@@ -201,9 +201,12 @@ class SegmentationResult:
     speed : ndarray, shape (K,)
         Mean speed per segment [m/s].
     time, lrms : ndarray
-        Decimated time [s] and local RMS [m] (channel geometric mean) series.
+        Decimated time [s] and local RMS [m] (channel geometric mean) series, in
+        the boundary band ``band``.
     criterion : dict
-        K -> penalised cost (when K was chosen), plus 'n_eff'.
+        K -> penalised cost (when K was chosen), plus 'n_eff' and 'B_eff_hz'.
+    band : tuple
+        Band-pass [Hz] of the partitioned signal and of ``lrms``.
     """
 
     t_bounds: np.ndarray
@@ -214,6 +217,7 @@ class SegmentationResult:
     time: np.ndarray
     lrms: np.ndarray
     criterion: dict = field(default_factory=dict)
+    band: tuple = (3.0, 20.0)
 
     @property
     def n_segments(self) -> int:
@@ -374,7 +378,8 @@ def segment(time, channels, speed, *, k=None, k_max: int = 8, window_s: float = 
             classes.append(cls)
     else:
         classes = [""] * K
-    return SegmentationResult(tb, classes, Gq, rms, vmean, t[::step], np.exp(logr[::step]), criterion)
+    return SegmentationResult(tb, classes, Gq, rms, vmean, t[::step], np.exp(logr[::step]), criterion,
+                              (f_hp, f_lp))
 
 
 def classify(rms: float, speed: float, predict_rms, w: float = 2.0, ref_class: str = "C"):
@@ -437,11 +442,14 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
     a1.plot(time, 1e3 * np.asarray(signal), lw=0.5, color="0.3")
     a1.set_ylabel("suspension displacement [mm]")
-    a2.semilogy(result.time, 1e3 * result.lrms, color="C0", lw=1.0, label="local RMS")
+    a1.set_title("red: segment boundaries found, with initial class; dashed: truth" if truth_bounds is not None
+                 else "segment boundaries found, with initial class", fontsize=9)
+    a2.semilogy(result.time, 1e3 * result.lrms, color="C0", lw=1.0, label="local RMS (eq 1)")
     for i in range(result.n_segments):
         a, b = result.t_bounds[i], result.t_bounds[i + 1]
-        a2.hlines(1e3 * result.rms[i], a, b, color="C3", lw=2,
-                  label="segment RMS" if i == 0 else None)
+        sel = (result.time >= a) & (result.time < b)
+        level = np.sqrt(np.mean(result.lrms[sel] ** 2)) if np.any(sel) else np.nan
+        a2.hlines(1e3 * level, a, b, color="C3", lw=2, label="segment RMS" if i == 0 else None)
         label = result.classes[i] or f"S{i + 1}"
         a1.text(0.5 * (a + b), 1.0, label, transform=a1.get_xaxis_transform(), ha="center",
                 va="bottom", fontsize=9)
@@ -451,7 +459,7 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
         if truth_bounds is not None:
             for tb in np.asarray(truth_bounds)[1:-1]:
                 ax.axvline(tb, color="k", lw=0.8, ls="--")
-    a2.set_ylabel("local RMS [mm]")
+    a2.set_ylabel(f"local RMS, {result.band[0]:g}-{result.band[1]:g} Hz [mm]")
     a2.set_xlabel("time [s]")
     a2.legend(loc="upper right", fontsize=8)
     if title:

@@ -33,7 +33,8 @@ Algorithm (per iteration)
 3. Identifiability: in prior-scaled coordinates the data information is
    G_k = S J_k^T W_k J_k S, S = diag(prior_sigma).  A parameter whose
    posterior-to-prior variance ratio diag((G_k + I)^-1) exceeds ``id_ratio``
-   (default 0.5: the data do not halve the prior variance) is NOT IDENTIFIABLE:
+   (default 0.25: the data do not halve the prior standard deviation) is NOT
+   IDENTIFIABLE:
    it is held at its current value for this step (and reported so); the others
    move.  The singular values of W^1/2 J_k S are reported as well.
 4. Step: one IPOPT solve (casadi.nlpsol) of the bounded trust-region subproblem
@@ -44,8 +45,9 @@ Algorithm (per iteration)
    ln nmax - ln nmin >= ln(min_ratio).
 5. Trial: one simulation at theta_c + d; per segment the ratio rho_k of actual
    to predicted reduction of the objective decides: rho_k > ``eta_accept``
-   accepts the segment's step, rho_k < 0.25 halves radius_k, rho_k > 0.75 with
-   the step on the trust-region edge doubles it (up to ``radius_max``).  Since
+   accepts the segment's step, rho_k < 0.25 halves radius_k (rho_k < 0
+   quarters it), rho_k > 0.75 with the step on the trust-region edge doubles it
+   (up to ``radius_max``).  Since
    the segments are separable, every segment has its own radius and acceptance.
 6. A segment has converged when an accepted step is below ``step_tol`` (scaled
    inf-norm), its predicted reduction is below ``pred_tol``, or its radius falls
@@ -89,7 +91,9 @@ class FitConfig:
     step_tol : float
         Accepted steps below this (scaled inf-norm) mark convergence.
     pred_tol : float
-        Predicted reductions below this mark convergence [objective units].
+        Predicted reductions below this mark convergence [objective units].  The
+        objective is a chi-square; a gain of 0.5 moves the parameters by well
+        under one standard deviation, below what the data resolve.
     max_iter : int
         Most iterations.
     prior_sigma : tuple of 4 float
@@ -103,17 +107,17 @@ class FitConfig:
 
     scale: tuple = (1.0, 0.25, 0.5, 0.3)
     radius0: float = 1.0
-    radius_min: float = 0.02
+    radius_min: float = 0.05
     radius_max: float = 3.0
     step_frac: float = 0.3
     h_min: float = 0.05
     h_max: float = 0.5
     eta_accept: float = 0.1
     step_tol: float = 0.02
-    pred_tol: float = 0.05
+    pred_tol: float = 0.5
     max_iter: int = 12
     prior_sigma: tuple = (math.log(4.0), 0.5, 1.0, 0.5)
-    id_ratio: float = 0.5
+    id_ratio: float = 0.25
     n_workers: int = 1
 
 
@@ -173,8 +177,11 @@ class FitResult:
     segments : list of SegmentFit
     history : list of dict
         One entry per iteration (iteration 0 = initial point): 'iter', 'theta',
-        'params' (lists), 'objective' (total), 'objective_segments', 'radius',
-        'rho', 'accepted', 'identifiable', 'n_sims' (cumulative), 'wall_s'.
+        'params' (lists, the iterate after the iteration), 'objective' (data
+        misfit + prior term, summed over segments), 'objective_segments',
+        'radius', 'rho', 'accepted', 'identifiable', 'converged',
+        'solver_status' (IPOPT's return status of the step), 'n_sims'
+        (cumulative), 'wall_s'.
     n_sims : int
         Simulations run.
     wall_s : float
@@ -364,8 +371,8 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
         sd = np.full((K, P), np.nan)
         svals = [[] for _ in range(K)]
 
-        def record(it, rho, accepted):
-            entry = {"iter": it, "theta": theta.tolist(), "params": theta_to_params(theta).tolist(),
+        def record(it, rho, accepted, status=""):
+            entry = {"iter": it, "solver_status": status, "theta": theta.tolist(), "params": theta_to_params(theta).tolist(),
                      "objective": float(obj_c.sum()), "objective_segments": obj_c.tolist(),
                      "radius": radius.tolist(), "rho": rho, "accepted": accepted,
                      "identifiable": ident.tolist(), "converged": converged.tolist(),
@@ -427,13 +434,15 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
                     obj_c[k] = obj_t[k]
                     if step < config.step_tol:
                         converged[k] = True
-                if r < 0.25:
+                if r < 0.0:  # the model was wrong about the direction: shrink hard
+                    radius[k] = 0.25 * min(radius[k], max(step, config.radius_min))
+                elif r < 0.25:
                     radius[k] = 0.5 * min(radius[k], max(step, config.radius_min))
                 elif r > 0.75 and step > 0.9 * radius[k]:
                     radius[k] = min(2.0 * radius[k], config.radius_max)
                 if radius[k] < config.radius_min:
                     converged[k] = True
-            record(it, rho, accepted)
+            record(it, rho, accepted, status)
             if converged.all():
                 break
     finally:

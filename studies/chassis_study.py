@@ -203,7 +203,6 @@ def _equivalent_segments(road) -> tuple[list[dict], str]:
     Gd(n0) and w fitted to the Welch PSD of all its tracks (``roadlib.metrics``).
     """
     from roadlib.metrics import fit_iso_psd, profile_psd
-    from roadlib.psd import N0  # noqa: F401  (documents the reference frequency)
     from roadlib.segments import RoadSegment
 
     meta = road.meta or {}
@@ -230,7 +229,8 @@ def _equivalent_segments(road) -> tuple[list[dict], str]:
                              f"{fit.Gd_n0:.3g} m^3, w = {fit.w:.2f}, class {fit.iso_class}")
 
 
-def road_specs(road_path: str | Path, n_seeds: int = 2, seed: int = 2026) -> tuple[list[dict], str]:
+def road_specs(road_path: str | Path, n_seeds: int = 2,
+               seed: int = 2026) -> tuple[list[dict], str]:
     """Road realisations of the study: the road file and equivalent synthetic roads.
 
     Parameters

@@ -15,7 +15,8 @@ What it is for:
 * the **findings table**: the paper's five statements on Figure 11, each judged true or
   false for our model by an explicit quantitative criterion (:data:`CRITERIA`,
   :func:`evaluate_findings`), every peak explained by the nearest mode of
-  :mod:`vehicles.modal`.
+  :mod:`vehicles.modal` and by the resonant mode of an exact modal decomposition of the
+  linearised response (:func:`mode_table`, :func:`dominant_mode`).
 
 It also holds the helpers that the chassis-stiffness study (:mod:`studies.chassis_study`)
 shares: the tractor variant (:func:`tractor_variant`), one drive with the base motion
@@ -23,6 +24,7 @@ shares: the tractor variant (:func:`tractor_variant`), one drive with the base m
 
 What it is not: the kinematics and spectra themselves (:mod:`studies.pantograph`), the
 vehicle model (:mod:`vehicles`), the command line (:mod:`studies.cli_pantograph`).
+See ``docs/pantograph.md`` for the method, the criteria and the results.
 """
 from __future__ import annotations
 
@@ -170,7 +172,8 @@ def tractor_variant(vehicle: Any = DEFAULT_VEHICLE, mount_factor: float = 1.0,
         raise EroadInputError(f"vehicle {vp.id}: no [dcdc] table, so no pantograph base")
     mount_factor = float(mount_factor)
     if not (math.isfinite(mount_factor) and mount_factor > 0):
-        raise EroadInputError(f"DCDC mount stiffness factor must be positive, got {mount_factor!r}")
+        raise EroadInputError(f"DCDC mount stiffness factor must be positive, "
+                              f"got {mount_factor!r}")
     vp = replace(vp, dcdc=replace(vp.dcdc, mount_stiffness_factor=vp.dcdc.mount_stiffness_factor
                                   * mount_factor))
     if joint_translational_stiffness is not None:
@@ -847,7 +850,8 @@ def plot_figure11(data: Figure11Data | str | Path, path: str | Path, *, f_max: f
     sel = (f > 0) & (f <= f_max)
     # smoothed amplitude: the root of the amplitude^2 smoothed like the findings' power
     kernel = smoothing_kernel(f[1] - f[0])
-    smooth = {k: np.sqrt(np.convolve(a ** 2, kernel, mode="same")) for k, a in data.spectra.items()}
+    smooth = {k: np.sqrt(np.convolve(a ** 2, kernel, mode="same"))
+              for k, a in data.spectra.items()}
     col_titles = ("angle / displacement", "velocity", "acceleration")
     fig, axes = plt.subplots(4, 3, figsize=(13, 11), sharex=True)
     marks = [m for m in data.modes if m["freq_hz"] <= f_max
@@ -1181,9 +1185,9 @@ def findings_markdown(findings: list[Finding], meta: dict | None = None) -> str:
                      f"{meta.get('duration_s', 0) - meta.get('t_skip_s', 0):.1f} s analysed.")
         lines.append("")
     lines.append(f"P = power spectrum (mean square per bin), P_s = P smoothed over "
-                 f"{SMOOTH_HZ:g} Hz (Hann-weighted), f_peak = frequency of the largest P_s in (0, {F_MAX:g}] Hz, "
-                 "E = band mean square; `X_max_6_10Hz_over_max` = largest P_s in 6-10 Hz / "
-                 "largest P_s (1 when the peak is in the band).")
+                 f"{SMOOTH_HZ:g} Hz (Hann-weighted), f_peak = frequency of the largest P_s "
+                 f"in (0, {F_MAX:g}] Hz, E = band mean square; `X_max_6_10Hz_over_max` = "
+                 "largest P_s in 6-10 Hz / largest P_s (1 when the peak is in the band).")
     lines.append("")
     lines.append("Modes: *nearest* = nearest natural frequency; *resonant* = among the modes "
                  "within 25 % (>= 0.5 Hz) of the peak, the one with the largest own "

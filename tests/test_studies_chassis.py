@@ -21,8 +21,7 @@ import pytest
 
 from studies.chassis_study import (STUDY, chassis_case, code_version, quick_config, road_specs,
                                    run_chassis_study, study_cases, trend_summary)
-from studies.figure11 import _solve_exact_with_yaw, development_road
-from studies.pantograph import point_displacements, solve_base_motion
+from studies.figure11 import development_road
 
 
 @pytest.fixture(scope="module")
@@ -117,22 +116,3 @@ def test_trend_summary_pairs_by_road():
 def test_code_version_covers_vehicle_model():
     v = code_version()
     assert v.startswith("eroad-") and len(v.split("+")[1]) == 12
-
-
-def test_exact_solver_anchor_leaves_samples_unchanged():
-    """The scale anchor of the exact solve (figure11) does not change the other samples."""
-    pts = np.array([[0.5, 0.8, 0.0], [0.5, -0.8, 0.0], [-0.5, -0.8, 0.0], [-0.5, 0.8, 0.0]])
-    t = np.arange(400) / 200.0
-    motion = (1e-3 * np.sin(7 * t), 2e-3 * np.cos(3 * t), 0.02 * np.sin(5 * t),
-              0.01 * np.cos(2 * t), 0.01 * np.sin(4 * t))
-    dy, dz = point_displacements(pts, *motion, method="exact")
-    direct = solve_base_motion(pts, dy, dz, method="exact", include_yaw=True)
-    via, anchored = _solve_exact_with_yaw(pts, dy, dz)
-    assert not anchored
-    ay, az = point_displacements(pts, 0.0, 0.0, 0.05, 0.05, 0.05, method="exact")
-    forced = solve_base_motion(pts, np.vstack([dy, ay]), np.vstack([dz, az]), method="exact",
-                               include_yaw=True)
-    for c in ("Ty", "Tz", "Rx", "Ry", "Rz"):
-        np.testing.assert_allclose(getattr(forced, c)[:-1], getattr(direct, c), rtol=0,
-                                   atol=1e-15)
-        np.testing.assert_array_equal(getattr(via, c), getattr(direct, c))

@@ -23,10 +23,11 @@ import numpy as np
 import pytest
 
 from eroad.cli import main
-from studies.figure11 import (CRITERIA, development_road, drive_base_motion, evaluate_findings,
-                              findings_markdown, kinematics_check, load_figure11, simulate_tractor,
-                              tractor_variant, write_findings)
-from studies.pantograph import check_points
+from studies.figure11 import (CRITERIA, _solve_exact_with_yaw, development_road,
+                              drive_base_motion, evaluate_findings, findings_markdown,
+                              kinematics_check, load_figure11, simulate_tractor, tractor_variant,
+                              write_findings)
+from studies.pantograph import check_points, point_displacements, solve_base_motion
 
 FS = 200.0
 
@@ -162,3 +163,22 @@ def test_drive_base_motion_skips_start(short_road):
     m = d["motion"]
     assert m.time[0] == 0.0
     assert m.time.size == int(round(3.0 * d["fs"])) + 1
+
+
+def test_exact_solver_anchor_leaves_samples_unchanged():
+    """The scale anchor of the exact solve (figure11) does not change the other samples."""
+    pts = np.array([[0.5, 0.8, 0.0], [0.5, -0.8, 0.0], [-0.5, -0.8, 0.0], [-0.5, 0.8, 0.0]])
+    t = np.arange(400) / 200.0
+    motion = (1e-3 * np.sin(7 * t), 2e-3 * np.cos(3 * t), 0.02 * np.sin(5 * t),
+              0.01 * np.cos(2 * t), 0.01 * np.sin(4 * t))
+    dy, dz = point_displacements(pts, *motion, method="exact")
+    direct = solve_base_motion(pts, dy, dz, method="exact", include_yaw=True)
+    via, anchored = _solve_exact_with_yaw(pts, dy, dz)
+    assert not anchored
+    ay, az = point_displacements(pts, 0.0, 0.0, 0.05, 0.05, 0.05, method="exact")
+    forced = solve_base_motion(pts, np.vstack([dy, ay]), np.vstack([dz, az]), method="exact",
+                               include_yaw=True)
+    for c in ("Ty", "Tz", "Rx", "Ry", "Rz"):
+        np.testing.assert_allclose(getattr(forced, c)[:-1], getattr(direct, c), rtol=0,
+                                   atol=1e-15)
+        np.testing.assert_array_equal(getattr(via, c), getattr(direct, c))
