@@ -5,8 +5,11 @@ contract (see :class:`QuarterTruckSimulator`) and runs in milliseconds, so the
 fit can be developed, tested and benchmarked without the Exudyn truck; and a
 closed-form linear model (:class:`QuarterTruck`) whose response RMS per road class
 feeds the segmentation's initial class guess.  What it is not: the vehicle model
-of the project (``vehicles``), nor a road library (``roadlib``): it carries its
-own small harmonic synthesis so that it has no dependency on roadlib's state.
+of the project (``vehicles``), nor a road library (``roadlib``).  It carries its
+own small harmonic synthesis because the fit needs phases that stay put when the
+parameters move (common random numbers): here one phase per bin of a fixed
+frequency grid, whereas ``roadlib.synthesis`` starts its harmonic grid and its
+phase draws at nmin, so a 10% change of nmin gives a new road.
 
 Model
 -----

@@ -442,8 +442,6 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
     a1.plot(time, 1e3 * np.asarray(signal), lw=0.5, color="0.3")
     a1.set_ylabel("suspension displacement [mm]")
-    a1.set_title("red: segment boundaries found, with initial class; dashed: truth" if truth_bounds is not None
-                 else "segment boundaries found, with initial class", fontsize=9)
     a2.semilogy(result.time, 1e3 * result.lrms, color="C0", lw=1.0, label="local RMS (eq 1)")
     for i in range(result.n_segments):
         a, b = result.t_bounds[i], result.t_bounds[i + 1]
@@ -454,14 +452,14 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
         a1.text(0.5 * (a + b), 1.0, label, transform=a1.get_xaxis_transform(), ha="center",
                 va="bottom", fontsize=9)
     for ax in (a1, a2):
-        for tb in result.t_bounds[1:-1]:
-            ax.axvline(tb, color="C3", lw=1)
+        for j, tb in enumerate(result.t_bounds[1:-1]):
+            ax.axvline(tb, color="C3", lw=1, label="boundary found" if (ax is a2 and j == 0) else None)
         if truth_bounds is not None:
-            for tb in np.asarray(truth_bounds)[1:-1]:
-                ax.axvline(tb, color="k", lw=0.8, ls="--")
+            for j, tb in enumerate(np.asarray(truth_bounds)[1:-1]):
+                ax.axvline(tb, color="k", lw=0.8, ls="--", label="true boundary" if (ax is a2 and j == 0) else None)
     a2.set_ylabel(f"local RMS, {result.band[0]:g}-{result.band[1]:g} Hz [mm]")
     a2.set_xlabel("time [s]")
-    a2.legend(loc="upper right", fontsize=8)
+    a2.legend(loc="lower right", fontsize=8)
     if title:
         fig.suptitle(title)
     fig.tight_layout()

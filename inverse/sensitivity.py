@@ -210,21 +210,27 @@ def replicate_seeds(seed: int, replicates: int) -> list:
 class _Evaluator:
     """Picklable simulate -> features map; log features averaged over replicates."""
 
-    def __init__(self, simulate, features: FeatureSet, seed: int):
-        self.simulate, self.features = simulate, features
+    def __init__(self, simulate, features: FeatureSet, seed: int, features_fn=None):
+        self.simulate, self.features, self.features_fn = simulate, features, features_fn
         self.seeds = replicate_seeds(seed, features.spec.replicates)
 
     def __call__(self, params):
         acc = None
         for s in self.seeds:
             try:
-                out = self.simulate(params, s)
+                if self.features_fn is not None:
+                    F = [np.asarray(f, dtype=float) for f in self.features_fn(params, s)]
+                else:
+                    F = self.features.evaluate(self.simulate(params, s))
             except EroadInputError:
                 raise
             except Exception as exc:  # a failed solve at a sample point
                 raise SimulationError(f"simulation at params {np.round(params, 6).tolist()} "
                                       f"seed {s} failed: {exc}") from exc
-            F = self.features.evaluate(out)
+            if len(F) != self.features.n_segments or any(f.shape != wf.y.shape
+                                                         for f, wf in zip(F, self.features.windows)):
+                raise EroadInputError("features callable must return one array per segment shaped like "
+                                      "the measured features")
             acc = F if acc is None else [a + f for a, f in zip(acc, F)]
         return [a / len(self.seeds) for a in acc]
 
@@ -294,9 +300,47 @@ def _design(theta, H, lo, hi):
     return out
 
 
+def check_common_random_numbers(simulate, params, seed: int = 0, steps=(0.1, 0.025, 0.1, 0.1)) -> dict:
+    """Does a simulator keep its road phases when the parameters move?
+
+    Runs the simulator at ``params`` and at ``params`` with one parameter of every
+    segment moved by a small step (ln Gq_n0 + 0.1, w + 0.025, ln nmin + 0.1,
+    ln nmax - 0.1), all with one seed, and correlates the responses.  With
+    common random numbers the responses barely change (correlation near 1); a
+    simulator that redraws phases when a parameter moves gives a correlation
+    near 0, and sampled sensitivities from it are noise.
+
+    Parameters
+    ----------
+    simulate : callable
+        Simulator with the contract of this module.
+    params : (K, 4) array
+        Physical parameters to test at.
+    seed : int
+    steps : tuple of 4 float
+        Steps in theta units.
+
+    Returns
+    -------
+    dict
+        Parameter name -> smallest correlation coefficient over the channels
+        [-]; the fit needs all of them close to 1 (say > 0.9).
+    """
+    P0 = np.atleast_2d(np.asarray(params, dtype=float))
+    base = simulate(P0, seed)
+    out = {}
+    for i, name in enumerate(PARAM_NAMES):
+        th = params_to_theta(P0)
+        th[:, i] += steps[i] if i != 3 else -steps[i]
+        moved = simulate(theta_to_params(th), seed)
+        out[name] = float(min(np.corrcoef(np.asarray(base[c], float), np.asarray(moved[c], float))[0, 1]
+                              for c in base))
+    return out
+
+
 def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
                  bounds: ParamBounds = ParamBounds(), config: FitConfig = FitConfig(),
-                 prior=None, map_fn=None, progress=None) -> FitResult:
+                 prior=None, map_fn=None, progress=None, features_fn=None) -> FitResult:
     """Fit the spectral parameters of every segment to the measured features.
 
     Parameters
@@ -323,6 +367,12 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
         process pool of ``config.n_workers`` when that is above 1.
     progress : callable, optional
         Called with each history entry as it is made.
+    features_fn : callable, optional
+        ``features_fn(params (K, 4), seed) -> list of K arrays``: simulated
+        features directly (aligned with ``features.windows[k].y``, e.g. from a
+        linear model's response PSDs), used instead of
+        ``features.evaluate(simulate(params, seed))``; ``simulate`` is then
+        ignored (may be None).
 
     Returns
     -------
@@ -341,7 +391,7 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
     y = [wf.y for wf in features.windows]
     W = [wf.weight for wf in features.windows]
 
-    evaluator = _Evaluator(simulate, features, seed)
+    evaluator = _Evaluator(simulate, features, seed, features_fn)
     pool = None
     if map_fn is None:
         if config.n_workers > 1:

@@ -28,9 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from eroad.errors import EroadInputError
-
-#: reference spatial frequency of ISO 8608 [cycles/m]
-N0 = 0.1
+from roadlib.psd import ISO_CLASSES, N0, class_of  # N0 re-exported for inverse.*
 
 #: column names of a (K, 4) physical parameter array
 PARAM_NAMES = ("Gq_n0", "w", "nmin", "nmax")
@@ -41,8 +39,8 @@ THETA_NAMES = ("ln_Gq_n0", "w", "ln_nmin", "ln_nmax")
 
 #: ISO 8608 road classes: geometric mean of Gd(n0) [m^3] (Table 1 of the standard;
 #: class A 16e-6 m^3, each class a factor 4 above the previous one; the class
-#: bounds lie a factor 2 either side).  Mirrors ``roadlib.psd.ISO_CLASSES``.
-ISO_CLASS_GD0 = {c: 16e-6 * 4.0 ** i for i, c in enumerate("ABCDEFGH")}
+#: bounds lie a factor 2 either side), from ``roadlib.psd.ISO_CLASSES``.
+ISO_CLASS_GD0 = {c: v.gd0 for c, v in ISO_CLASSES.items()}
 
 
 def iso_class(Gq_n0: float) -> str:
@@ -56,15 +54,13 @@ def iso_class(Gq_n0: float) -> str:
     Returns
     -------
     str
-        'A' ... 'H': the class whose geometric mean is nearest in log, which is the
-        class whose bounds (a factor 2 either side of the mean) contain ``Gq_n0``.
-        Levels beyond H are reported as 'H', below A as 'A'.
+        'A' ... 'H': the class whose bounds (a factor 2 either side of its
+        geometric mean) contain ``Gq_n0``, i.e. the class nearest in log
+        (``roadlib.psd.class_of``; A open downwards, H upwards).
     """
     if not (Gq_n0 > 0 and math.isfinite(Gq_n0)):
         raise EroadInputError(f"iso_class: Gq_n0 must be a positive number, got {Gq_n0!r}")
-    names = list(ISO_CLASS_GD0)
-    logs = np.log([ISO_CLASS_GD0[c] for c in names])
-    return names[int(np.argmin(np.abs(logs - math.log(Gq_n0))))]
+    return class_of(Gq_n0)
 
 
 def params_to_theta(params) -> np.ndarray:
