@@ -27,6 +27,7 @@ COMMAND_MODULES = (
     "inverse.cli",
     "studies.cli",
     "studies.cli_pantograph",
+    "studies.reproduce",
     "diagnosis.cli",
 )
 

@@ -24,13 +24,23 @@ wavenumbers, i.e. sets the lateral coherence.  A 1D profile is the case of a
 single lateral harmonic m = 0 (deterministic amplitudes a_k = sqrt(2 Gd dn)).
 
 Grid path: the harmonics sit on the FFT grid of a period N_x dx >= the road
-length (and >= 2 / nmin), so on x_i = x0 + i dx the sum is an inverse real FFT
-along x after a small matrix product across y; the numbers equal the explicit
-cosine sum to round-off (tests check it).
+length and >= 2 / GRID_NMIN (400 m; 2 / nmin only if nmin < GRID_NMIN), so on
+x_i = x0 + i dx the sum is an inverse real FFT along x after a small matrix
+product across y; the numbers equal the explicit cosine sum to round-off
+(tests check it).
+
+Common random numbers: the frequency grid depends on the road length, dx and
+``n_fft`` only, never on the band.  One phase is drawn for EVERY bin
+k = 0 .. N_x/2 and every lateral harmonic l, in that order, whatever the band;
+the band [nmin, nmax] is an amplitude mask, fractional for the bins straddling
+an edge (weight = the share of the bin [n_k - dn/2, n_k + dn/2] inside the
+band), so with one seed a change of Gq_n0, w, nmin, nmax or lam changes the
+amplitudes only and the road changes continuously with every parameter
+(``inverse.sensitivity`` relies on this: docs/inverse.md).
 
 Seeds: ``seed`` (int or ``numpy.random.SeedSequence``) is used as
-``SeedSequence(seed)``; its generator draws the phases, row by row in k, then
-l.  Same seed and parameters, same bytes.
+``SeedSequence(seed)``; its generator draws the phases of the whole grid, row by
+row in k, then l.  Same seed and parameters, same bytes.
 """
 from __future__ import annotations
 
@@ -48,6 +58,10 @@ from roadlib.psd import ISO_BAND, class_gd0, iso_psd, lateral_density
 LATERAL_PERIOD_FACTOR = 4.0
 #: longitudinal period is at least this many longest wavelengths 1/nmin
 MIN_PERIODS_OF_NMIN = 2.0
+#: the frequency grid resolves down to this frequency [cycles/m] whatever nmin
+#: is (period >= MIN_PERIODS_OF_NMIN / GRID_NMIN = 400 m), so the grid -- and the
+#: phases, keyed by bin -- do not move with nmin (common random numbers)
+GRID_NMIN = 0.005
 
 
 @dataclass(frozen=True)
@@ -236,6 +250,34 @@ class HarmonicField:
         return z
 
 
+def band_weights(n, dn: float, nmin: float, nmax: float) -> np.ndarray:
+    """Share of each frequency bin [n - dn/2, n + dn/2] inside [nmin, nmax] [-].
+
+    The amplitude mask of the synthesis: 1 inside the band, 0 outside, the
+    overlap fraction for a bin straddling an edge, so the synthesised variance
+    is the integral of the PSD over the band and moves continuously with nmin
+    and nmax.
+
+    Parameters
+    ----------
+    n : array_like
+        Bin centres [cycles/m].
+    dn : float
+        Bin width [cycles/m].
+    nmin, nmax : float
+        Band [cycles/m].
+
+    Returns
+    -------
+    ndarray
+        Weights in [0, 1], the shape of ``n``.
+    """
+    n = np.asarray(n, float)
+    lo = np.maximum(n - 0.5 * dn, nmin)
+    hi = np.minimum(n + 0.5 * dn, nmax)
+    return np.clip((hi - lo) / dn, 0.0, 1.0)
+
+
 def harmonic_field(params: SpectralParams, length: float, width: float = 0.0,
                    seed=0, n_fft: int | None = None, lateral: bool | None = None) -> HarmonicField:
     """Draw the harmonics of a road of the given size.
@@ -251,7 +293,10 @@ def harmonic_field(params: SpectralParams, length: float, width: float = 0.0,
     seed : int or numpy.random.SeedSequence
         Root of the phase stream.
     n_fft : int, optional
-        Force the FFT length (default: fast length >= length/dx + 1 and >= 2/(nmin dx)).
+        Force the FFT length (default: fast length >= length/dx + 1 and
+        >= 2/(min(nmin, GRID_NMIN) dx)).  The phases are keyed by the bins of
+        this grid, so keep it fixed (the default is, for nmin >= GRID_NMIN)
+        when comparing roads of one seed with different parameters.
     lateral : bool, optional
         Force lateral harmonics on/off (default: on when width > 0).
 
@@ -267,19 +312,20 @@ def harmonic_field(params: SpectralParams, length: float, width: float = 0.0,
         raise EroadInputError(f"road length {length!r} m is shorter than one dx = {dx} m")
     if width < 0 or not math.isfinite(width):
         raise EroadInputError(f"road width must be >= 0 m, got {width!r}")
-    need = max(nx, int(math.ceil(MIN_PERIODS_OF_NMIN / (params.nmin * dx))))
+    need = max(nx, int(math.ceil(MIN_PERIODS_OF_NMIN / (min(params.nmin, GRID_NMIN) * dx))))
     if n_fft is None:
         n_fft = scipy.fft.next_fast_len(need, real=True)
     elif n_fft < nx:
         raise EroadInputError(f"n_fft = {n_fft} is shorter than the road ({nx} samples)")
     dn = 1.0 / (n_fft * dx)
-    k_lo = int(math.ceil(params.nmin / dn - 1e-9))
-    k_hi = min(int(math.floor(params.nmax / dn + 1e-9)), n_fft // 2)
-    k = np.arange(max(k_lo, 1), k_hi + 1)
-    if k.size == 0:
+    n_bins = n_fft // 2 + 1
+    weight = band_weights(np.arange(n_bins) * dn, dn, params.nmin, params.nmax)
+    weight[0] = 0.0
+    if params.nmax - params.nmin < dn or not np.any(weight > 0):
         raise EroadInputError(
             f"no harmonic between nmin = {params.nmin} and nmax = {params.nmax} cycles/m "
             f"at frequency step {dn:.3g} cycles/m; widen the band or lengthen the road")
+    k = np.flatnonzero(weight > 0)
     n = k * dn
     gd = iso_psd(n, params.Gq_n0, params.w)
     if lateral is None:
@@ -294,10 +340,12 @@ def harmonic_field(params: SpectralParams, length: float, width: float = 0.0,
     else:
         m = np.zeros(1)
         q = np.ones((n.size, 1))
-    amp = np.sqrt(2.0 * gd[:, None] * dn * q)
+    amp = np.sqrt(2.0 * gd[:, None] * dn * weight[k][:, None] * q)
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     rng = np.random.default_rng(ss)
-    phi = rng.uniform(0.0, 2.0 * np.pi, size=amp.shape)
+    # one phase per bin of the whole grid (k = 0 .. n_fft/2) and lateral harmonic,
+    # whatever the band: the phases depend on (seed, k, l) only
+    phi = rng.uniform(0.0, 2.0 * np.pi, size=(n_bins, m.size))[k]
     coef = amp * np.exp(1j * phi)
     return HarmonicField(n=n, k=k, m=m, coef=coef, dx=dx, n_fft=int(n_fft))
 

@@ -23,8 +23,15 @@ def test_junction_steps_bounded(width):
     the roughness that is there.  Measured over 30 seeds x 2 junctions of this A-E-B road
     (41 lines each): largest ratio 2.94, mean 1.8; seed 0 is not the worst case.  The
     unpatched concatenation would jump by the offset the patches removed, asserted to be
-    > 3x the bound, so the test can fail."""
-    s = _road(seed=0, width=width)
+    > 3x the bound, so the test can fail.
+
+    Seed changed 0 -> 3 on 2026-11-21: the synthesis now draws one phase per bin of a
+    fixed grid (common random numbers, issue 5), which changed every realisation; with
+    the new phases seed 0 removes an offset of only 1.8x the bound at one junction (the
+    patch still holds: step ratio 0.27), so it no longer shows what an unpatched
+    junction would do.  Seed 3: step ratios 0.29/0.05 (width 0) and 0.76/0.66 (4 m),
+    offsets 5.7/4.5 and 3.9/11.8 x the bound."""
+    s = _road(seed=3, width=width)
     steps = np.abs(np.diff(s.z, axis=0))
     x_mid = s.x[:-1] + 0.5 * s.dx
     segs, juncs = s.meta["segments"], s.meta["junctions"]

@@ -1,0 +1,287 @@
+"""``eroad reproduce``: every paper figure and table from the embedded dataset.
+
+What it is for: one command that runs the whole chain on the embedded ``luliang``
+dataset (the virtual test drive of the paper's 460-490 s coal-road window) and
+writes one folder with every paper item, the chassis-stiffness study, the gap
+diagnosis and a manifest that maps each paper item to the file and the code that
+made it.  What it is not: a place where science is done; each step calls the
+package that owns it, and this module only wires the steps and keeps the record.
+
+Steps (each in its own sub-folder of the run):
+
+==========  ======================================  ==========================================
+step        paper items                             code
+==========  ======================================  ==========================================
+dataset     (input)                                 drives.synth.default_dataset
+fig4_5      Figures 4, 5                            drives.figures.plot_figures
+invert      Figures 6, 8, 9; Tables 1, 2; road      inverse.cli.invert_dataset
+figure11    Figure 11 and the findings table        studies.figure11.run_figure11
+chassis     chassis-stiffness study                 studies.chassis_study.run_chassis_study
+diagnose    sim-to-real gap of the dataset          diagnosis.pipeline.diagnose_dataset
+==========  ======================================  ==========================================
+
+The run folder is written under a temporary name beside ``--out`` and renamed into
+place when complete, so an interrupted run never leaves a half-written ``--out``
+and never overwrites another run (an existing non-empty ``--out`` is refused
+unless ``--force``, which moves the old folder aside rather than deleting it).
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import sys
+import time
+from pathlib import Path
+
+from eroad.errors import EroadInputError
+
+#: paper item -> (step, file pattern relative to the run folder, code)
+MANIFEST = [
+    ("Figure 4", "fig4_5", "figure4_displacement.png", "drives.figures.plot_figures"),
+    ("Figure 5", "fig4_5", "figure5_spectrum.png", "drives.figures.plot_figures"),
+    ("Figure 6", "invert", "figures/figure6_segmentation.png", "inverse.cli.invert_dataset"),
+    ("Table 1", "invert", "table1.md", "inverse.cli.invert_dataset"),
+    ("Figure 8", "invert", "figures/figure8_time.png", "inverse.cli.invert_dataset"),
+    ("Figure 9", "invert", "figures/figure9_amplitude.png", "inverse.cli.invert_dataset"),
+    ("Table 2", "invert", "table2.md", "inverse.cli.invert_dataset"),
+    ("Global road (section 2.5)", "invert", "road.npz", "inverse.cli.invert_dataset"),
+    ("Figure 11", "figure11", "figures/figure11.png", "studies.figure11.run_figure11"),
+    ("Findings of section 5 (true/false)", "figure11", "data/findings.md",
+     "studies.figure11.run_figure11"),
+    ("Chassis-stiffness study", "chassis", "figures/*.png", "studies.chassis_study.run_chassis_study"),
+    ("Sim-to-real gap diagnosis", "diagnose", "report.md", "diagnosis.pipeline.diagnose_dataset"),
+]
+
+
+def _step_dataset(run: Path, quick: bool, workers: int, log) -> dict:
+    """Copy the embedded dataset (without ``truth/``) into the run."""
+    from drives.synth import default_dataset
+
+    src = default_dataset()
+    dst = run / "dataset"
+    dst.mkdir()
+    for name in ("channels.csv", "meta.toml", "vehicle.toml"):
+        if (src / name).is_file():
+            shutil.copy2(src / name, dst / name)
+    return {"source": str(src), "path": str(dst),
+            "regenerate": "eroad synth --scenario luliang --seed 0 --out DIR"}
+
+
+def _step_fig4_5(run: Path, quick: bool, workers: int, log) -> dict:
+    from drives.figures import plot_figures
+    from drives.format import read_drive
+
+    out = run / "fig4_5"
+    out.mkdir()
+    summary = plot_figures(read_drive(run / "dataset"), out)
+    return _jsonable(summary)
+
+
+def _step_invert(run: Path, quick: bool, workers: int, log) -> dict:
+    from inverse.cli import invert_dataset
+
+    return _jsonable(invert_dataset(run / "dataset", run / "invert", quick=quick,
+                                    workers=workers, seed=0))
+
+
+def _identified_road(run: Path) -> Path:
+    road = run / "invert" / "road.npz"
+    if not road.is_file():
+        raise EroadInputError(f"{road}: missing; the inversion step did not write the global road")
+    return road
+
+
+def _archived(root: Path, study: str) -> Path:
+    """Move the single archived run ``root/<study>/<run-id>`` up to ``root``."""
+    runs = [p for p in (root / study).iterdir() if p.is_dir()]
+    if len(runs) != 1:
+        raise RuntimeError(f"expected one archived run in {root / study}, found {len(runs)}")
+    for item in runs[0].iterdir():
+        item.rename(root / item.name)
+    runs[0].rmdir()
+    (root / study).rmdir()
+    return root
+
+
+def _step_figure11(run: Path, quick: bool, workers: int, log) -> dict:
+    from studies.figure11 import run_figure11
+
+    out = run / "figure11"
+    out.mkdir()
+    summary = run_figure11(_identified_road(run), out, duration=15.0 if quick else 30.0,
+                           command=sys.argv)
+    _archived(out, "figure11")
+    return _jsonable(summary)
+
+
+def _step_chassis(run: Path, quick: bool, workers: int, log) -> dict:
+    from studies.chassis_study import full_config, quick_config, run_chassis_study
+
+    out = run / "chassis"
+    out.mkdir()
+    config = quick_config() if quick else full_config()
+    summary = run_chassis_study(_identified_road(run), out, config, n_workers=workers,
+                                cache_dir=run.parent / ".eroad-cache", progress=False,
+                                command=sys.argv)
+    _archived(out, "chassis_stiffness")
+    return _jsonable(summary)
+
+
+def _step_diagnose(run: Path, quick: bool, workers: int, log) -> dict:
+    from diagnosis.pipeline import diagnose_dataset
+
+    return _jsonable(diagnose_dataset(run / "dataset", run / "diagnose", quick=quick,
+                                      workers=workers))
+
+
+STEPS = [("dataset", _step_dataset), ("fig4_5", _step_fig4_5), ("invert", _step_invert),
+         ("figure11", _step_figure11), ("chassis", _step_chassis), ("diagnose", _step_diagnose)]
+
+
+def _jsonable(obj):
+    """Round-trip through JSON with str() for anything unknown (paths, numpy scalars)."""
+    def default(o):
+        try:
+            import numpy as np
+            if isinstance(o, np.generic):
+                return o.item()
+            if isinstance(o, np.ndarray):
+                return o.tolist()
+        except ImportError:  # pragma: no cover
+            pass
+        return str(o)
+    return json.loads(json.dumps(obj, default=default))
+
+
+def _manifest(run: Path) -> list:
+    rows = []
+    for item, step, pattern, code in MANIFEST:
+        files = sorted(str(p.relative_to(run)) for p in (run / step).glob(pattern)) \
+            if (run / step).is_dir() else []
+        rows.append({"item": item, "files": files, "code": code, "present": bool(files)})
+    return rows
+
+
+def _manifest_md(rows: list, timings: dict) -> str:
+    lines = ["# eroad reproduce: manifest", "",
+             "Each paper item, the file(s) that show it (relative to this folder) and the "
+             "code that made them.", "",
+             "| paper item | file(s) | code |", "|---|---|---|"]
+    for r in rows:
+        files = "<br>".join(f"[{f}]({f})" for f in r["files"]) or "**missing**"
+        lines.append(f"| {r['item']} | {files} | `{r['code']}` |")
+    lines += ["", "## Timing", "", "| step | wall [s] |", "|---|---|"]
+    lines += [f"| {k} | {v:.1f} |" for k, v in timings.items()]
+    return "\n".join(lines) + "\n"
+
+
+def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False,
+              steps=None, log=print) -> dict:
+    """Run every step into ``out`` and write the manifest.
+
+    Parameters
+    ----------
+    out : str or Path
+        Run folder to create; refused when it exists and is not empty, unless
+        ``force`` (the old folder is renamed to ``<out>.old-<timestamp>``, not deleted).
+    quick : bool
+        Smoke-test settings (shorter fits, fewer study cases; <= 2 minutes).
+    workers : int
+        Worker processes for the parallel steps.
+    steps : list of str, optional
+        Subset of step names (default all; later steps need the earlier ones).
+    log : callable
+        Progress lines.
+
+    Returns
+    -------
+    dict
+        The summary (also ``summary.json``): per-step summaries, timings, manifest.
+    """
+    from studies.runs import git_state, package_versions, write_json_atomic
+
+    out = Path(out)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        if not force:
+            raise EroadInputError(f"{out}: exists and is not empty; choose another --out or use --force")
+        aside = out.with_name(f"{out.name}.old-{time.strftime('%Y%m%dT%H%M%S')}")
+        out.rename(aside)
+        log(f"moved the old {out} aside to {aside}")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f".{out.name}.tmp-{os.getpid()}")
+    if tmp.exists():
+        shutil.rmtree(tmp)
+    tmp.mkdir()
+    wanted = [name for name, _ in STEPS] if steps is None else list(steps)
+    start = time.time()
+    record = {"command": sys.argv, "quick": quick, "workers": workers, "git": git_state(),
+              "versions": package_versions(), "start": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+              "status": "running"}
+    timings, results = {}, {}
+    try:
+        for name, func in STEPS:
+            if name not in wanted:
+                continue
+            log(f"[{name}] ...")
+            t0 = time.perf_counter()
+            results[name] = func(tmp, quick, workers, log)
+            timings[name] = time.perf_counter() - t0
+            log(f"[{name}] done in {timings[name]:.1f} s")
+        record["status"] = "complete"
+    except BaseException as exc:
+        record["status"] = "failed"
+        record["error"] = f"{type(exc).__name__}: {exc}"
+        raise
+    finally:
+        record["wall_s"] = time.time() - start
+        record["timings_s"] = timings
+        rows = _manifest(tmp)
+        write_json_atomic(tmp / "run.json", record)
+        summary = {"status": record["status"], "quick": quick, "timings_s": timings,
+                   "wall_s": record["wall_s"], "manifest": rows, "steps": results}
+        write_json_atomic(tmp / "summary.json", _jsonable(summary))
+        write_json_atomic(tmp / "manifest.json", rows)
+        (tmp / "manifest.md").write_text(_manifest_md(rows, timings))
+        target = out if record["status"] == "complete" else out.with_name(f"{out.name}.failed-{os.getpid()}")
+        if target.exists():
+            target.rmdir()  # empty (checked above)
+        tmp.rename(target)
+    return summary
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "reproduce", help="every paper figure and table from the embedded dataset",
+        description="Run the whole chain on the embedded luliang dataset: Figures 4, 5, 6, 8, "
+        "9, 11, Tables 1, 2, the chassis-stiffness study and the gap diagnosis, with a "
+        "manifest mapping each paper item to its file and code.")
+    p.add_argument("--out", default="out/reproduce", help="run folder to create (default out/reproduce)")
+    p.add_argument("--quick", action="store_true", help="smoke-test settings (<= 2 minutes)")
+    p.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    p.add_argument("--force", action="store_true",
+                   help="if --out exists, move it aside (never deleted) and write a new run")
+    p.add_argument("--steps", default=None,
+                   help="comma-separated subset of steps: " + ",".join(n for n, _ in STEPS))
+    p.add_argument("--json", action="store_true", help="print summary.json")
+    p.set_defaults(func=_cmd)
+
+
+def _cmd(args) -> int:
+    steps = None if args.steps is None else [s.strip() for s in args.steps.split(",") if s.strip()]
+    if steps is not None:
+        unknown = sorted(set(steps) - {n for n, _ in STEPS})
+        if unknown:
+            raise EroadInputError(f"--steps: unknown step(s) {', '.join(unknown)}; "
+                                  f"choose from {', '.join(n for n, _ in STEPS)}")
+    summary = reproduce(args.out, quick=args.quick, workers=args.workers, force=args.force,
+                        steps=steps, log=(lambda *a: None) if args.json else
+                        (lambda msg: print(msg, flush=True)))
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        missing = [r["item"] for r in summary["manifest"] if not r["present"]]
+        print(f"wrote {args.out} in {summary['wall_s']:.0f} s; manifest: {args.out}/manifest.md")
+        if missing:
+            print("not produced: " + ", ".join(missing))
+    return 0
