@@ -1,0 +1,82 @@
+"""Blind benchmark of ``eroad diagnose`` (issue 7, item 2) and its timing.
+
+Makes ``--n`` synthetic drives (``eroad synth --scenario null --seed S --effect
+NAME.PARAM=VALUE``: the nominal truck plus ONE effect at a random strength, random road
+and speed; about one in five a null case with no effect), diagnoses each from a copy
+without ``truth/`` with the whole effect library, and prints:
+
+* per case: truth, verdict and confidence, predicted and true shrink, localisation hit,
+  wall time of the diagnosis;
+* the confusion matrix (rows truth, columns verdict), top-1 accuracy, the rate of
+  "none" on null cases, confident wrong attributions, localisation hit rate, mean
+  |predicted - true shrink|;
+* the wall time per diagnosis against a reference measured in the same run (one
+  nominal 30 s simulation of the truck), so that the number travels between machines.
+
+Targets (issue 7): >= 30 cases, top-1 >= 90 %, null "none" >= 90 %, no confident wrong
+attribution.  Results go to ``OUT/blind.json`` and ``OUT/confusion.txt``; a run can be
+resumed (cases already in blind.json are kept).
+
+Usage::
+
+    nice python benchmarks/bench_diagnosis.py --n 30 --out results/diagnosis-blind [--workers 2]
+
+Timings are printed, never asserted.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+
+def reference_time() -> float:
+    """Wall time of one nominal 30 s simulation of the dump truck (class C, 10 m/s)."""
+    from roadlib.segments import RoadSegment, segmented_surface
+    from vehicles.simulate import simulate
+
+    road = segmented_surface([RoadSegment(Gq_n0=256e-6, share=330.0)], 330.0, 3.0, 0.05, 0.1, seed=1)
+    t = time.perf_counter()
+    simulate("dump_truck_8x4", road, 10.0, 30.0)
+    return time.perf_counter() - t
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--n", type=int, default=30, help="number of blind cases (default 30)")
+    ap.add_argument("--out", default="results/diagnosis-blind", help="work and result folder")
+    ap.add_argument("--seed", type=int, default=0, help="root seed of the cases")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--duration", type=float, default=None, help="record length [s] (default 30)")
+    args = ap.parse_args(argv)
+
+    from diagnosis.blind import format_confusion, run_blind
+
+    ref = reference_time()
+    print(f"reference: one nominal 30 s truck simulation {ref:.2f} s", flush=True)
+    t = time.perf_counter()
+    out = run_blind(args.out, args.n, seed=args.seed, workers=args.workers, duration=args.duration,
+                    progress=lambda m: print(m, flush=True))
+    wall = time.perf_counter() - t
+    sc = out["score"]
+    res = out["results"]
+    print("\nconfusion matrix (rows truth, columns verdict):")
+    print(format_confusion(sc))
+    d = [r["diagnose_s"] for r in res]
+    print(f"\ncases {sc['n_cases']}: top-1 {sc['top1_accuracy']:.2f} (effect cases "
+          f"{sc['effect_top1_accuracy']:.2f}), null 'none' {sc['null_none_rate']:.2f}, "
+          f"confident wrong {sc['confident_wrong']}, localisation hits "
+          f"{sc['localisation_hit_rate']:.2f}, mean |pred - true shrink| {sc['shrink_mean_abs_diff']}")
+    print(f"diagnosis wall time: mean {sum(d) / len(d):.1f} s, max {max(d):.1f} s "
+          f"({sum(d) / len(d) / ref:.0f} x the reference simulation); whole run {wall:.0f} s")
+    Path(args.out, "timing.json").write_text(json.dumps(
+        {"reference_sim_s": ref, "diagnose_s": d, "wall_s": wall}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

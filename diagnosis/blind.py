@@ -1,0 +1,250 @@
+"""The blind check of ``eroad diagnose``: synthetic drives with one withheld effect.
+
+What it is for: make datasets whose truth vehicle is the nominal model plus ONE effect
+of the library at a random strength (random road, speed and strength from the case
+seed), plus null cases (truth = nominal), diagnose each from a copy WITHOUT
+``truth/``, and score:
+
+* **attribution**: top-1 verdict against the truth effect ("none" for null cases);
+  a *confident wrong attribution* is a wrong verdict with confidence "clear";
+* **localisation**: a case is a hit when a flagged cell (any segment) lies in a
+  band and channel quantity where the effect acts (:data:`ACTS`); for a null case
+  when nothing is flagged;
+* **how far**: predicted shrink (the verdict's ``shrink_fraction``) against the
+  true shrink, the held-out shrink of the truth effect at its true strength on the
+  same seeds (:func:`diagnosis.pipeline.heldout_shrink`).
+
+Decision: one-effect cases are made from the ``null`` scenario (``eroad synth
+--scenario null --seed S --effect NAME=VALUE``): its truth vehicle is the nominal model
+(rigid frame, nominal time step), so the effect is the only model difference.  The
+``random`` scenario keeps a flexible 8-segment frame in its truth even with
+``--no-default-effects`` (the chassis is not an effect there), which would make
+every case a frame_flex + X case.
+
+What it is not: a test (``tests/test_diagnosis_cli.py`` has the slow-marked one) or
+a timing benchmark (``benchmarks/bench_diagnosis.py`` runs it and prints times).
+"""
+from __future__ import annotations
+
+import json
+import math
+import time as _time
+from pathlib import Path
+
+import numpy as np
+
+#: truth strength per effect: (parameter, lo, hi, log, random sign of the change)
+STRENGTHS = {
+    "frame_flex": ("stiffness_factor", 0.3, 3.0, True, False),
+    "leaf_friction": ("force", 1500.0, 6000.0, False, False),
+    "bump_stop": ("gap", 0.01, 0.025, False, False),
+    "damper_asymmetry": ("ratio", 2.5, 5.0, False, False),
+    "payload": ("mass", 3000.0, 8000.0, False, True),
+    "speed_scale": ("factor", 0.06, 0.12, False, True),     # |factor - 1|
+    "sensor": ("cutoff", 6.0, 20.0, True, False),
+    "tyre_enveloping": ("length", 0.25, 0.5, False, False),
+}
+#: where each effect acts: (channel quantities, band lo, band hi [Hz]) for the localisation score
+ACTS = {
+    "frame_flex": (("body_acc",), 3.0, 25.0),
+    "leaf_friction": (("body_acc", "susp_disp", "axle_acc"), 1.0, 20.0),
+    "bump_stop": (("body_acc", "susp_disp", "axle_acc"), 0.5, 56.0),
+    "damper_asymmetry": (("body_acc", "susp_disp", "axle_acc"), 0.5, 56.0),
+    "payload": (("body_acc", "susp_disp"), 0.5, 5.0),
+    "speed_scale": (("body_acc", "susp_disp", "axle_acc"), 0.5, 56.0),
+    "sensor": (("body_acc", "susp_disp", "axle_acc"), None, 56.0),   # lo = cutoff / 2
+    "tyre_enveloping": (("axle_acc", "body_acc", "susp_disp"), 4.0, 56.0),
+}
+#: the ranking budget of the blind run (the whole library, no pairs)
+BLIND_SETTINGS = dict(n_seeds=3, n_null=4, grid=4, refine=3, pairs=False)
+
+
+def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None) -> list[dict]:
+    """``n`` blind cases: effects in turn (strength drawn per case), every ``k``-th a null case.
+
+    Parameters
+    ----------
+    n : int
+        Number of cases.
+    seed : int
+        Root seed; case ``i`` uses dataset seed ``1000 * seed + 100 + i`` and strength stream
+        ``SeedSequence(seed, spawn_key=(7, i))``.
+    n_null : int, optional
+        Null cases among them (default ``round(n / 5)``, at least 1).
+    effects : sequence of str, optional
+        Effects used (default all of :data:`STRENGTHS`).
+
+    Returns
+    -------
+    list of dict with ``case``, ``seed``, ``effect`` ("none" for null), ``param``, ``value``.
+    """
+    names = list(effects or STRENGTHS)
+    n_null = max(1, round(n / 5)) if n_null is None else n_null
+    null_at = set(np.linspace(0, n - 1, n_null).round().astype(int).tolist()) if n_null else set()
+    cases, k = [], 0
+    for i in range(n):
+        ds_seed = 1000 * seed + 100 + i
+        if i in null_at:
+            cases.append(dict(case=i, seed=ds_seed, effect="none", param=None, value=None))
+            continue
+        name = names[k % len(names)]
+        k += 1
+        pname, lo, hi, log, signed = STRENGTHS[name]
+        rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(7, i)))
+        u = rng.uniform()
+        v = math.exp(math.log(lo) + u * (math.log(hi) - math.log(lo))) if log else lo + u * (hi - lo)
+        sign = (1.0 if rng.uniform() < 0.5 else -1.0) if signed else 1.0
+        v = 1.0 + sign * v if name == "speed_scale" else sign * v
+        cases.append(dict(case=i, seed=ds_seed, effect=name, param=pname, value=float(v)))
+    return cases
+
+
+def localisation_hit(summary: dict, effect: str, value=None) -> bool:
+    """Did the diagnosis flag a cell where ``effect`` acts (nothing flagged for "none")?"""
+    flagged = [c for c in summary.get("localization", []) if c.get("significant")]
+    if effect == "none":
+        return not flagged
+    quants, lo, hi = ACTS[effect]
+    if lo is None:
+        lo = 0.5 * float(value)
+    for c in flagged:
+        b0, b1 = c["band_hz"]
+        if c["channel"].startswith(quants) and b1 >= lo and b0 <= hi:
+            return True
+    return False
+
+
+def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None,
+             progress=print) -> dict:
+    """Make, blind-copy, diagnose and score one case.
+
+    Returns
+    -------
+    dict: the case, verdict, confidence, predicted and true shrink, localisation hit, times.
+    """
+    from diagnosis.pipeline import diagnose, heldout_shrink
+    from drives.synth import copy_without_truth, read_truth, synth_command
+    from eroad.errors import EroadInputError
+
+    root = Path(root)
+    ds = root / f"case{case['case']:03d}"
+    blind = root / f"case{case['case']:03d}-blind"
+    run = root / f"case{case['case']:03d}-run"
+    eff_items = [] if case["effect"] == "none" else [f"{case['effect']}.{case['param']}={case['value']!r}"]
+    t0 = _time.perf_counter()
+    if not (ds / "truth" / "summary.json").is_file():
+        # a very rough random road can drive the truth outside the plausible range of the
+        # measurement format (e.g. |axle_acc| > 200 m/s^2): redraw road and speed
+        for attempt in range(6):
+            try:
+                synth_command(scenario="null", seed=case["seed"], effects=eff_items, out=ds,
+                              force=True, duration=duration)
+                break
+            except EroadInputError as exc:
+                if attempt == 5:
+                    raise
+                progress(f"case {case['case']}: seed {case['seed']} not usable ({exc}); redrawn")
+                case["seed"] += 7919
+    if not blind.exists():
+        copy_without_truth(ds, blind)
+    t1 = _time.perf_counter()
+    settings = dict(BLIND_SETTINGS, **(settings or {}))
+    summ = diagnose(blind, run, workers=workers, force=True, settings=settings,
+                    progress=lambda m: None)
+    t2 = _time.perf_counter()
+    # scoring only from here: truth is read
+    truth = read_truth(ds)
+    truth_eff = truth["vehicle"]["truth"]["effects"]
+    verdict = summ["verdict"]
+    entry = next((e for e in summ.get("ranking", []) if e["effect"] == verdict), None)
+    pred_shrink = float(entry["shrink_fraction"]) if entry else 0.0
+    true_shrink = None
+    if truth_eff:
+        oracle = {k: dict(v) for k, v in truth_eff.items()}
+        if "sensor" in oracle:        # the nominal model carries the measured noise floor
+            oracle["sensor"].update(acc_noise=0.0, disp_noise=0.0)
+        true_shrink = heldout_shrink(blind, oracle, n_seeds=settings["n_seeds"])["shrink_fraction"]
+    t3 = _time.perf_counter()
+    res = dict(case, verdict=verdict, confidence=summ.get("verdict_confidence"),
+               correct=(verdict == case["effect"]),
+               confident_wrong=(verdict != case["effect"] and verdict != "none"
+                                and summ.get("verdict_confidence") == "clear"),
+               localisation_hit=localisation_hit(summ, case["effect"], case["value"]),
+               n_flagged=sum(1 for c in summ.get("localization", []) if c.get("significant")),
+               predicted_shrink=pred_shrink, true_shrink=true_shrink,
+               best_parameters=entry["parameters"] if entry else None,
+               synth_s=round(t1 - t0, 1), diagnose_s=round(t2 - t1, 1), oracle_s=round(t3 - t2, 1))
+    progress(f"case {case['case']:3d} truth {case['effect']:>16s} "
+             f"{'' if case['value'] is None else format(case['value'], '.4g'):>8s} -> "
+             f"{verdict:>16s} ({res['confidence']}) shrink pred {pred_shrink:.2f} "
+             f"true {'-' if true_shrink is None else format(true_shrink, '.2f')}  "
+             f"loc {'hit' if res['localisation_hit'] else 'miss'}  {t2 - t1:.0f} s")
+    return res
+
+
+def score(results: list[dict]) -> dict:
+    """Confusion matrix (truth rows x verdict columns) and the target metrics."""
+    labels = sorted({r["effect"] for r in results} | {r["verdict"] for r in results},
+                    key=lambda s: (s == "none", s))
+    idx = {l: i for i, l in enumerate(labels)}
+    cm = np.zeros((len(labels), len(labels)), int)
+    for r in results:
+        cm[idx[r["effect"]], idx[r["verdict"]]] += 1
+    eff = [r for r in results if r["effect"] != "none"]
+    nul = [r for r in results if r["effect"] == "none"]
+    pairs = [(r["predicted_shrink"], r["true_shrink"]) for r in eff
+             if r["correct"] and r["true_shrink"] is not None]
+    return {
+        "n_cases": len(results),
+        "top1_accuracy": float(np.mean([r["correct"] for r in results])) if results else float("nan"),
+        "effect_top1_accuracy": float(np.mean([r["correct"] for r in eff])) if eff else float("nan"),
+        "null_none_rate": float(np.mean([r["verdict"] == "none" for r in nul])) if nul else float("nan"),
+        "confident_wrong": int(sum(r["confident_wrong"] for r in results)),
+        "localisation_hit_rate": float(np.mean([r["localisation_hit"] for r in results]))
+        if results else float("nan"),
+        "shrink_pred_vs_true": [[float(a), float(b)] for a, b in pairs],
+        "shrink_mean_abs_diff": float(np.mean([abs(a - b) for a, b in pairs])) if pairs else None,
+        "labels": labels,
+        "confusion": cm.tolist(),
+    }
+
+
+def format_confusion(sc: dict) -> str:
+    """The confusion matrix as a text table (rows truth, columns verdict)."""
+    labels = sc["labels"]
+    w = max(len(l) for l in labels) + 1
+    short = [l[:8] for l in labels]
+    lines = ["truth \\ verdict".ljust(w) + " ".join(s.rjust(8) for s in short)]
+    for l, row in zip(labels, sc["confusion"]):
+        lines.append(l.ljust(w) + " ".join(str(v).rjust(8) for v in row))
+    return "\n".join(lines)
+
+
+def run_blind(root, n: int = 30, *, seed: int = 0, workers: int = 2, duration=None, settings=None,
+              progress=print) -> dict:
+    """Run ``n`` blind cases under ``root``; write ``root/blind.json`` and ``root/confusion.txt``.
+
+    Cases already scored in ``root/blind.json`` are reused (the run can be resumed).
+    """
+    root = Path(root)
+    root.mkdir(parents=True, exist_ok=True)
+    done_file = root / "blind.json"
+    done = {}
+    if done_file.is_file():
+        done = {r["case"]: r for r in json.loads(done_file.read_text()).get("results", [])}
+    results = []
+    t0 = _time.perf_counter()
+    # case ids are stable; a redrawn road changes a case's dataset seed (recorded in results)
+    for case in make_cases(n, seed):
+        r = done.get(case["case"])
+        if r is None or r.get("value") != case["value"]:
+            r = run_case(case, root, workers=workers, settings=settings, duration=duration,
+                         progress=progress)
+        results.append(r)
+        sc = score(results)
+        done_file.write_text(json.dumps({"results": results, "score": sc,
+                                         "settings": dict(BLIND_SETTINGS, **(settings or {})),
+                                         "wall_s": _time.perf_counter() - t0}, indent=1))
+    sc = score(results)
+    (root / "confusion.txt").write_text(format_confusion(sc) + "\n")
+    return {"results": results, "score": sc}

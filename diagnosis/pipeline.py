@@ -1,0 +1,729 @@
+"""Diagnosis of a measured drive against the Exudyn truck: the wiring behind ``eroad diagnose``.
+
+What it is for: read a dataset (never its ``truth/``), identify the road per segment
+with the nominal model on calibration data, localise the gap, run the road-independent
+comparisons, rank the effects of :data:`vehicles.effects.EFFECTS` and write the report.
+What it is not: the statistics (``diagnosis.where``, ``compare``, ``which``, ``gap``)
+or the vehicle model (``vehicles.simulate``).
+
+Road identification (the cheap road fit, decision)
+-------------------------------------------------
+The full inverse fit (``inverse.pipeline.invert``) costs minutes per model; the
+ranking needs one road fit per candidate and per calibration evaluation (about 150).
+The diagnosis therefore keeps the road *shape* fixed (``w = 2``, ``nmin = 0.1``,
+``nmax = 5`` cycles/m, the ISO 8608 defaults) and identifies the *level* ``Gq(n0)``
+per segment:
+
+1. Segments: :func:`inverse.segmentation.segment` on the suspension displacements
+   (level-based change points, BIC for K).
+2. Nominal level, once: one simulation over the whole record on a class-C reference
+   road; per segment ``Gq = Gq_ref * mean_c(P_meas,c / P_sim,c)`` over the channels
+   (geometric mean) on the CALIBRATION samples of the segment only.  Exact for a
+   linear model (response power scales with ``Gq``).
+3. For each model (nominal or with an effect) and each simulated window, the road
+   level is re-profiled per segment piece: the simulated piece is scaled by
+   ``sqrt(mean_c P_meas / P_sim)`` (geometric mean over channels, smooth 0.5 s
+   ramps between pieces).  This is the fit ``rank_effects`` asks for (road
+   identified on the data with the effect fixed) at the cost of no extra
+   simulation; exact for a linear model, first order for the nonlinear effects
+   (friction, bump stop, damper asymmetry), which see the level of step 2.
+
+Sensor noise: the measured record carries white sensor noise the simulation lacks.
+Its level per channel is estimated from the measured spectrum between 0.6 and 0.95 of
+the Nyquist frequency (the minimum over 4 s blocks, as ``inverse.features``) and
+seeded white noise of that level is added to every simulation ("the nominal model"
+includes the measured noise floor).  The ``sensor`` candidate calibrates the cutoff
+only, with its own noise switched off.
+
+Calibration / held-out split (decision): the record is cut into ``n_windows``
+(default 4) equal time windows; windows 1 and 3 (odd, counted from 1) calibrate,
+windows 2 and 4 are held out.  Alternating windows put every long road segment into
+both sets.  Each window is simulated on its own (2 s run-in at the window's starting
+speed, discarded).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import time as _time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from diagnosis.signals import Signals, as_signals
+from eroad.errors import EroadInputError
+
+#: ISO 8608 road shape kept fixed by the cheap road fit
+ROAD_W, ROAD_NMIN, ROAD_NMAX = 2.0, 0.1, 5.0
+#: reference level of the first (nominal) simulation [m^3] (class C mean)
+GQ_REF = 256e-6
+#: run-in simulated and discarded before every window [s]
+RUNIN_S = 2.0
+#: road grid of the diagnosis simulations [m] (the nominal grid; truth uses finer)
+ROAD_DX, ROAD_DY, ROAD_WIDTH = 0.05, 0.1, 3.0
+#: measured channel prefixes used
+QUANTITIES = ("susp_disp_", "axle_acc_", "body_acc_")
+#: smoothing ramp between segment pieces of different level [s]
+RAMP_S = 0.5
+#: pieces shorter than this take the level of the whole window [s]
+MIN_PIECE_S = 1.5
+
+#: candidate search ranges (name -> {param: (lo, hi)}, primary parameter only) narrower
+#: than the library's validity ranges: the physically sensible span of a model error
+#: for the 8x4 dump truck.  The library's own range is used for effects not listed.
+SEARCH = {
+    "frame_flex": {"stiffness_factor": (0.1, 100.0)},
+    "tyre_enveloping": {"length": (0.05, 0.6)},
+    "leaf_friction": {"force": (200.0, 12000.0)},
+    "bump_stop": {"gap": (0.005, 0.08)},
+    "damper_asymmetry": {"ratio": (0.3, 6.0)},
+    "payload": {"mass": (-8000.0, 8000.0)},
+    "speed_scale": {"factor": (0.85, 1.15)},
+    "sensor": {"cutoff": (3.0, 60.0)},
+}
+#: parameters held fixed in the candidates (the sensor's noise is part of the nominal model)
+FIXED = {"sensor": {"acc_noise": 0.0, "disp_noise": 0.0}}
+#: effects tried by ``--quick``
+QUICK_EFFECTS = ("frame_flex", "leaf_friction", "payload", "sensor")
+
+
+def _say(msg):
+    print(msg, flush=True)
+
+
+# --------------------------------------------------------------------------- noise
+
+def noise_std(sig: Signals, names, block_s: float = 4.0) -> dict:
+    """White-noise std per channel from the top of the measured spectrum.
+
+    Mean PSD between 0.6 and 0.95 of the Nyquist frequency, minimum over blocks of
+    ``block_s`` seconds, times the Nyquist bandwidth.
+
+    Returns
+    -------
+    dict name -> std (channel unit)
+    """
+    from scipy import signal
+
+    fs = sig.fs
+    n = int(block_s * fs)
+    out = {}
+    for c in names:
+        x = sig.channels[c]
+        vals = []
+        for i0 in range(0, max(1, x.size - n + 1), n):
+            seg = x[i0:i0 + n]
+            if seg.size < 64:
+                continue
+            f, p = signal.welch(seg - seg.mean(), fs=fs, nperseg=min(256, seg.size))
+            m = (f >= 0.6 * fs / 2) & (f <= 0.95 * fs / 2)
+            vals.append(float(np.mean(p[m])))
+        psd = min(vals) if vals else 0.0
+        out[c] = math.sqrt(psd * fs / 2.0)
+    return out
+
+
+def noise_from_residual(sig: Signals, sim: dict) -> dict:
+    """White-noise std per channel: measured minus simulated (noise-free) PSD between 0.6 and
+    0.95 of the Nyquist frequency, floored at zero, times the Nyquist bandwidth."""
+    from scipy import signal
+
+    fs = sig.fs
+    out = {}
+    for c, x in sig.channels.items():
+        f, pm = signal.welch(x - x.mean(), fs=fs, nperseg=512)
+        _, ps = signal.welch(sim[c] - sim[c].mean(), fs=fs, nperseg=512)
+        m = (f >= 0.6 * fs / 2) & (f <= 0.95 * fs / 2)
+        out[c] = math.sqrt(max(float(np.mean(pm[m]) - np.mean(ps[m])), 0.0) * fs / 2.0)
+    return out
+
+
+# --------------------------------------------------------------------------- the model
+
+@dataclass
+class TruckModel:
+    """The nominal truck driven like the measured record (picklable; simulations built
+    inside each process).
+
+    Parameters
+    ----------
+    vehicle : str or Path
+        Built-in id or vehicle TOML.
+    time : (N,) array, s
+        Record time from 0.
+    speed : (N,) array, m/s
+        Recorded speed.
+    bounds : (K + 1,) array, s
+        Road-segment boundaries (record time from 0, reference axle).
+    gq : (K,) array, m^3
+        Road level per segment (``GQ_REF`` before the level fit).
+    w : (K,) array, optional
+        Road waviness per segment (default ``ROAD_W``).
+    noise : dict channel -> std
+        White sensor noise added to simulations.
+    channels : list of str
+        Channels returned.
+    ref_axle : int
+        Axle whose position defines the segment boundaries (1-based).
+    """
+
+    vehicle: object
+    time: np.ndarray
+    speed: np.ndarray
+    bounds: np.ndarray
+    gq: np.ndarray
+    noise: dict
+    channels: list
+    ref_axle: int = 3
+    w: np.ndarray | None = None
+    _roads: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def __getstate__(self):
+        d = dict(self.__dict__)
+        d["_roads"] = {}
+        return d
+
+    @property
+    def fs(self) -> float:
+        return float((self.time.size - 1) / (self.time[-1] - self.time[0]))
+
+    def _vp(self):
+        from vehicles.params import load_vehicle
+
+        vp = getattr(self, "_vp_cache", None)
+        if vp is None:
+            vp = load_vehicle(self.vehicle)
+            object.__setattr__(self, "_vp_cache", vp)
+        return vp
+
+    def _plan(self, t0: float, t1: float):
+        """Sim-time speed samples, axle-1 start position and the road for window [t0, t1)."""
+        fs = self.fs
+        n_run = int(round(RUNIN_S * fs))
+        i0 = int(round(t0 * fs))
+        i1 = min(int(round(t1 * fs)), self.time.size)
+        v_rec = self.speed[i0:i1]
+        v = np.concatenate([np.full(n_run, v_rec[0]), v_rec])
+        tau = np.arange(v.size) / fs
+        s = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) / fs)])
+        vp = self._vp()
+        ax = [a.x for a in vp.axles]
+        x_start = -min(ax) + 1.5
+        x_ref = x_start + ax[self.ref_axle - 1] + s
+        t_rec = t0 + tau - RUNIN_S
+        return tau, v, s, x_start, x_ref, t_rec, n_run, i1 - i0
+
+    def _road(self, t0, t1, seed, gq):
+        from roadlib.segments import RoadSegment, segmented_surface
+
+        wv = np.full(len(gq), ROAD_W) if self.w is None else np.asarray(self.w, float)
+        key = (round(t0, 6), round(t1, 6), int(seed), tuple(np.round(np.log(gq), 9)),
+               tuple(np.round(wv, 9)))
+        if key in self._roads:
+            return self._roads[key]
+        tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1)
+        length = x_start + s[-1] + 3.0
+        xb = np.interp(self.bounds[1:-1], t_rec, x_ref)
+        edges = np.concatenate([[0.0], np.clip(xb, 0.0, length), [length]])
+        segs, k_used = [], []
+        for k in range(len(gq)):
+            L = edges[k + 1] - edges[k]
+            if L > 2 * ROAD_DX:
+                segs.append(RoadSegment(Gq_n0=float(gq[k]), share=float(L), w=float(wv[k]),
+                                        nmin=ROAD_NMIN, nmax=ROAD_NMAX, lam=1.0))
+                k_used.append(k)
+        road = segmented_surface(segs, float(sum(s_.share for s_ in segs)), ROAD_WIDTH, ROAD_DX,
+                                 ROAD_DY, seed=int(seed))
+        if len(self._roads) > 64:
+            self._roads.clear()
+        self._roads[key] = road
+        return road
+
+    def run(self, effects, t0: float, t1: float, seed: int, gq=None) -> dict:
+        """Noise-free channels over record window [t0, t1) s (run-in discarded)."""
+        from vehicles.simulate import SpeedProfile, simulate
+
+        gq = self.gq if gq is None else np.asarray(gq, float)
+        tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1)
+        road = self._road(t0, t1, seed, gq)
+        prof = SpeedProfile(tau, v)
+        dur = (tau.size - 1) / self.fs
+        res = simulate(self.vehicle, road, prof, dur, effects=effects or None, x_start=x_start,
+                       fs_out=self.fs, seed=int(seed))
+        out = {}
+        for c in self.channels:
+            x = np.asarray(res.channels[c], float)[n_run:n_run + n]
+            if x.size < n:
+                x = np.concatenate([x, np.full(n - x.size, x[-1])])
+            out[c] = x
+        return out
+
+    def add_noise(self, chans: dict, seed: int) -> dict:
+        ss = np.random.SeedSequence(int(seed), spawn_key=(0x4E01,)).spawn(len(self.channels))
+        return {c: chans[c] + self.noise.get(c, 0.0) * np.random.default_rng(s).standard_normal(chans[c].size)
+                for c, s in zip(self.channels, ss)}
+
+    def pieces(self, t0: float, t1: float):
+        """(index slices) of the segment pieces inside window [t0, t1) in window samples."""
+        fs = self.fs
+        n = int(round(t1 * fs)) - int(round(t0 * fs))
+        out = []
+        for k in range(len(self.bounds) - 1):
+            a = max(self.bounds[k], t0) - t0
+            b = min(self.bounds[k + 1], t1) - t0
+            if b - a > 1.0 / fs:
+                out.append((k, int(round(a * fs)), min(n, int(round(b * fs)))))
+        return out
+
+
+def _power(x):
+    return float(np.var(x)) if x.size > 1 else float("nan")
+
+
+def level_scale(model: TruckModel, meas: dict, sim: dict, t0: float, t1: float) -> np.ndarray:
+    """Per-sample amplitude factor that re-levels ``sim`` per segment piece to ``meas``.
+
+    Power ratio per channel (measured less its noise power), geometric mean over
+    channels, square root; pieces shorter than ``MIN_PIECE_S`` take the window's
+    factor; 0.5 s linear ramps between pieces.
+    """
+    fs = model.fs
+    n = next(iter(sim.values())).size
+
+    def factor(a, b):
+        logs = []
+        for c in model.channels:
+            pm = _power(meas[c][a:b]) - model.noise.get(c, 0.0) ** 2
+            pm = max(pm, 0.1 * _power(meas[c][a:b]))
+            ps = _power(sim[c][a:b])
+            if ps > 0 and pm > 0:
+                logs.append(math.log(pm / ps))
+        return math.exp(0.5 * float(np.mean(logs))) if logs else 1.0
+
+    whole = factor(0, n)
+    g = np.full(n, whole)
+    pcs = model.pieces(t0, t1)
+    vals = []
+    for k, a, b in pcs:
+        f = factor(a, b) if (b - a) / fs >= MIN_PIECE_S else whole
+        g[a:b] = f
+        vals.append((a, b, f))
+    # smooth steps between pieces
+    r = int(RAMP_S * fs / 2)
+    for (a0, b0, f0), (a1, b1, f1) in zip(vals[:-1], vals[1:]):
+        lo, hi = max(0, b0 - r), min(n, a1 + r)
+        if hi - lo > 1:
+            g[lo:hi] = np.linspace(f0, f1, hi - lo)
+    return g
+
+
+# --------------------------------------------------------------------------- the callables
+
+@dataclass(frozen=True)
+class State:
+    """A fitted model: effects (the road is re-levelled per simulated window)."""
+
+    effects: dict
+
+
+class Fit:
+    """``fit(effects, data) -> State`` for :func:`diagnosis.which.rank_effects`."""
+
+    def __init__(self, model: TruckModel):
+        self.model = model
+
+    def __call__(self, effects, data):
+        return State({k: dict(v) for k, v in (effects or {}).items()})
+
+
+class Simulate:
+    """``simulate(state, window, seed) -> Signals``: the truck with the state's effects over a
+    fresh road (seed), re-levelled per segment piece to ``window``, plus sensor noise."""
+
+    def __init__(self, model: TruckModel):
+        self.model = model
+
+    def __call__(self, state, window, seed):
+        w = as_signals(window)
+        m = self.model
+        t0 = float(w.meta["t0"])
+        t1 = t0 + w.time.size / m.fs
+        try:
+            sim = m.run(state.effects, t0, t1, seed)
+        except Exception as exc:  # a diverging candidate scores as a very bad model
+            from eroad.errors import SimulationError
+            if not isinstance(exc, SimulationError):
+                raise
+            sim = {c: np.zeros(w.time.size) for c in m.channels}
+            sim = {c: x + 1e3 for c, x in sim.items()}
+        g = level_scale(m, w.channels, sim, t0, t1) if any(np.var(x) > 0 for x in sim.values()) else 1.0
+        sim = {c: x * g for c, x in sim.items()}
+        sim = m.add_noise(sim, seed)
+        return Signals(w.time, sim, dict(w.units), w.speed, {"model": "truck", **state.effects})
+
+
+# --------------------------------------------------------------------------- dataset -> model
+
+def load_measured(dataset):
+    """Read the dataset (``drives.format.read_drive``; ``truth/`` is never read).
+
+    Returns
+    -------
+    (Drive, Signals) with time from 0 and only the measured suspension/axle/body channels.
+    """
+    from drives.format import read_drive
+
+    drive = read_drive(dataset)
+    names = [c for c in drive.channel_names if c.startswith(QUANTITIES)]
+    if not names:
+        raise EroadInputError(f"{dataset}: no susp_disp/axle_acc/body_acc channels to diagnose")
+    t = np.asarray(drive.time, float)
+    sig = Signals(t - t[0], {c: np.asarray(drive.channels[c], float) for c in names},
+                  {c: drive.units.get(c, "") for c in names}, np.asarray(drive.speed, float),
+                  {"dataset": drive.name, "t0": 0.0})
+    return drive, sig
+
+
+def windows(sig: Signals, n_windows: int = 4):
+    """Alternating calibration / held-out windows: (calib, heldout) lists of Signals."""
+    T = sig.time.size / sig.fs
+    edges = np.linspace(0.0, T, n_windows + 1)
+    cal, held = [], []
+    for i in range(n_windows):
+        w = sig.window(edges[i], edges[i + 1])
+        w = Signals(w.time, w.channels, w.units, w.speed, {**sig.meta, "t0": float(edges[i]),
+                                                           "window": i + 1})
+        (cal if i % 2 == 0 else held).append(w)
+    return cal, held, edges
+
+
+def road_segments(sig: Signals, k=None):
+    """Segment boundaries [s] from the suspension displacements (inverse.segmentation)."""
+    from inverse.segmentation import segment
+
+    disp = {c: x for c, x in sig.channels.items() if c.startswith("susp_disp_3")} or \
+        {c: x for c, x in sig.channels.items() if c.startswith("susp_disp_")}
+    res = segment(sig.time, disp, sig.speed, k=k)
+    b = np.asarray(res.t_bounds, float)
+    b[0], b[-1] = 0.0, sig.time.size / sig.fs
+    return b
+
+
+#: band of the waviness fit [Hz] and the channel quantities used (road-driven, little
+#: affected by the body-side effects)
+W_FIT_BAND = (1.0, 12.0)
+W_FIT_QUANTITIES = ("susp_disp_", "axle_acc_")
+W_RANGE = (1.2, 3.0)
+
+
+def _runs(mask):
+    """(start, stop) of the True runs of a boolean array."""
+    d = np.diff(np.concatenate([[0], mask.astype(int), [0]]))
+    return list(zip(np.nonzero(d == 1)[0], np.nonzero(d == -1)[0]))
+
+
+def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
+    """Nominal road level and waviness per segment from calibration samples (one simulation).
+
+    The whole record is simulated once on a reference road (``GQ_REF``, ``w = 2``).  Per
+    segment, on its calibration samples (0.5 s after the segment start skipped), the log
+    ratio of measured to simulated band power in the third octaves of ``W_FIT_BAND`` over
+    the channels of ``W_FIT_QUANTITIES`` (measured noise power removed) is regressed on
+    ``ln(f / (v n0))``: for a linear model a road ``Gq (n/n0)^-w`` gives exactly
+    ``ln(P_meas/P_sim) = ln(Gq/GQ_REF) + (2 - w) ln(f/(v n0))``.  The level then comes
+    from the total power over all channels (as the re-levelling does).
+
+    Returns
+    -------
+    (gq, w) : (K,) arrays [m^3], [-]
+    """
+    from scipy import signal
+
+    from diagnosis.bandpower import third_octave_bands
+
+    T = sig.time.size / sig.fs
+    K = len(model.bounds) - 1
+    model.w = np.full(K, ROAD_W)
+    sim = model.run({}, 0.0, T, seed, gq=np.full(K, GQ_REF))
+    fs = sig.fs
+    calmask = np.zeros(sig.time.size, bool)
+    for a, b in calib_edges:
+        calmask[int(round(a * fs)):int(round(b * fs))] = True
+    skip = int(0.5 * fs)
+    bands = third_octave_bands(*W_FIT_BAND)
+    wchan = [c for c in model.channels if c.startswith(W_FIT_QUANTITIES)] or list(model.channels)
+    gq, w = np.empty(K), np.full(K, ROAD_W)
+    for k in range(K):
+        a, b = int(round(model.bounds[k] * fs)), int(round(model.bounds[k + 1] * fs))
+        m = np.zeros_like(calmask)
+        m[min(a + skip, b):b] = True
+        mk = m & calmask
+        if mk.sum() < 2.0 * fs:     # too little calibration data here: use the whole segment
+            mk = m if m.sum() >= fs else np.zeros_like(m)
+            if not mk.any():
+                mk[a:b] = True
+        v = float(np.mean(sig.speed[mk]))
+        runs = [(i, j) for i, j in _runs(mk) if j - i >= 256]
+        if runs:
+            xs, ys = [], []
+            for c in wchan:
+                pm = ps = 0.0
+                for i, j in runs:
+                    f, p1 = signal.welch(sig.channels[c][i:j] - sig.channels[c][i:j].mean(), fs=fs,
+                                         nperseg=256)
+                    _, p2 = signal.welch(sim[c][i:j] - sim[c][i:j].mean(), fs=fs, nperseg=256)
+                    pm, ps = pm + p1 * (j - i), ps + p2 * (j - i)
+                nz = 2.0 * model.noise.get(c, 0.0) ** 2 / fs * sum(j - i for i, j in runs)
+                for lo, fc, hi in bands:
+                    sel = (f >= lo) & (f < hi)
+                    if sel.sum() == 0:
+                        continue
+                    bm = float(np.sum(pm[sel]) - nz * sel.sum())
+                    bs = float(np.sum(ps[sel]))
+                    if bm > 0 and bs > 0:
+                        xs.append(math.log(fc / (v * 0.1)))
+                        ys.append(math.log(bm / bs))
+            if len(set(np.round(xs, 6))) >= 3:
+                slope = float(np.polyfit(xs, ys, 1)[0])
+                w[k] = float(np.clip(ROAD_W - slope, *W_RANGE))
+        # level over all channels with the fitted tilt applied to the reference simulation
+        logs = []
+        for c in model.channels:
+            x = sig.channels[c][mk]
+            pm = max(_power(x) - model.noise.get(c, 0.0) ** 2, 0.1 * _power(x))
+            ps = _power(sim[c][mk])
+            if ps > 0 and pm > 0:
+                logs.append(math.log(pm / ps))
+        gq[k] = GQ_REF * math.exp(float(np.mean(logs))) if logs else GQ_REF
+    # the level above was measured with w = 2; re-simulate once with the fitted w and re-level
+    model.w = w
+    sim2 = model.run({}, 0.0, T, seed, gq=gq)
+    for k in range(K):
+        a, b = int(round(model.bounds[k] * fs)), int(round(model.bounds[k + 1] * fs))
+        mk = np.zeros_like(calmask)
+        mk[min(a + skip, b):b] = True
+        mk &= calmask
+        if mk.sum() < fs:
+            mk[:] = False
+            mk[a:b] = True
+        logs = []
+        for c in model.channels:
+            x = sig.channels[c][mk]
+            pm = max(_power(x) - model.noise.get(c, 0.0) ** 2, 0.1 * _power(x))
+            ps = _power(sim2[c][mk])
+            if ps > 0 and pm > 0:
+                logs.append(math.log(pm / ps))
+        if logs:
+            gq[k] *= math.exp(float(np.mean(logs)))
+    return gq, w
+
+
+def candidates(names=None):
+    """Candidates over the library, primary parameter only, ranges of :data:`SEARCH`."""
+    from diagnosis.which import Candidate, Param
+    from vehicles.effects import EFFECTS
+
+    out = []
+    for name in (names or list(EFFECTS)):
+        if name not in EFFECTS:
+            raise EroadInputError(f"--effects: unknown effect {name!r}; known: {', '.join(EFFECTS)}")
+        eff = EFFECTS[name]
+        pname = eff.primary
+        par = eff.parameter(pname)
+        lo, hi = SEARCH.get(name, {}).get(pname, tuple(par.range))
+        fixed = {p.name: p.default for p in eff.parameters if p.name != pname}
+        fixed.update(FIXED.get(name, {}))
+        out.append(Candidate(name, (Param(pname, float(lo), float(hi),
+                                          log=(lo > 0 and hi / lo >= 10)),), fixed))
+    return out
+
+
+# --------------------------------------------------------------------------- the diagnosis
+
+@dataclass
+class Context:
+    """What the diagnosis knows after the road fit (see :func:`prepare`)."""
+
+    model: TruckModel
+    calib: list
+    held: list
+    edges: np.ndarray
+    bounds: np.ndarray
+    cal_edges: list
+    sim_nominal: dict
+    segs: list
+    road_fit_s: float
+
+
+def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4) -> Context:
+    """Segments, noise, calibration/held-out windows, nominal road levels, and the nominal
+    simulation of the whole record (road-phase seed ``seed + 1``, noise-free)."""
+    t = _time.perf_counter()
+    bounds = road_segments(sig)
+    noise = noise_std(sig, list(sig.channels))
+    model = TruckModel(vehicle, sig.time, sig.speed, bounds, np.full(len(bounds) - 1, GQ_REF), noise,
+                       list(sig.channels))
+    calib, held, edges = windows(sig, n_windows)
+    cal_edges = [(float(edges[i]), float(edges[i + 1])) for i in range(n_windows) if i % 2 == 0]
+    model.gq, model.w = fit_road(model, sig, cal_edges, seed)
+    T = sig.time.size / sig.fs
+    simc = model.run({}, 0.0, T, seed + 1)
+    model.noise = noise_from_residual(sig, simc)
+    segs = [(f"S{k + 1}", float(bounds[k]), float(bounds[k + 1])) for k in range(len(bounds) - 1)]
+    return Context(model, calib, held, edges, bounds, cal_edges, simc, segs,
+                   _time.perf_counter() - t)
+
+
+def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: int = 4,
+                   n_windows: int = 4) -> dict:
+    """Held-out gap of the nominal model and of the model with ``effects`` (given, not
+    calibrated), on the seeds ``rank_effects`` uses: the "true shrink" of a blind case
+    when ``effects`` is the truth.
+
+    Returns
+    -------
+    dict with ``before``, ``after`` (mean gaps) and ``shrink_fraction``.
+    """
+    from diagnosis.which import _Scorer
+
+    drive, sig = load_measured(dataset)
+    ctx = prepare(sig, vehicle if vehicle is not None else drive.vehicle, seed=seed,
+                  n_windows=n_windows)
+    sc = _Scorer(Fit(ctx.model), Simulate(ctx.model), ctx.calib, ctx.held, seed, 1, n_seeds,
+                 None, None)
+    before = float(np.mean([g.value for g in sc.heldout_gaps({})]))
+    after = float(np.mean([g.value for g in sc.heldout_gaps(effects)]))
+    return {"before": before, "after": after, "shrink_fraction": 1.0 - after / before}
+
+
+def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quick: bool = False,
+             force: bool = False, seed: int = 0, n_windows: int = 4, settings=None,
+             progress=_say) -> dict:
+    """Diagnose a measured dataset against the nominal truck and write the report.
+
+    Parameters
+    ----------
+    dataset : str or Path
+        Dataset folder (measurement format); ``truth/`` is not read.
+    out : str or Path
+        Run folder (refused if it exists and is not empty, unless ``force``).
+    vehicle : str or Path, optional
+        Nominal vehicle (built-in id or TOML); default the dataset's vehicle.
+    effects : sequence of str, optional
+        Candidate effects (default: the whole library; ``quick``: ``QUICK_EFFECTS``).
+    workers : int
+        Processes for the candidate calibrations.
+    quick : bool
+        CI smoke settings: 4 candidates, 3 held-out seeds, 4 null pairs, a 3 + 3
+        search, no pairs.
+    force : bool
+        Replace an existing report.
+    seed : int
+        Root seed of all road phases.
+    n_windows : int
+        Alternating windows (odd calibrate, even held out).
+    settings : dict, optional
+        Overrides of the ``rank_effects`` budget (``n_seeds``, ``n_null``, ``grid``,
+        ``refine``, ``pairs``, ...).
+
+    Returns
+    -------
+    dict
+        The summary written to ``out/summary.json``.
+    """
+    from concurrent.futures import ProcessPoolExecutor
+
+    from diagnosis.compare import distribution_shape, front_rear, transmissibility
+    from diagnosis.report import write_report
+    from diagnosis.which import rank_effects
+    from diagnosis.where import localize
+    from vehicles.params import load_vehicle
+
+    wall0 = _time.perf_counter()
+    out = Path(out)
+    if out.exists() and any(out.iterdir()) and not force:
+        raise EroadInputError(f"{out}: exists and is not empty (use --force to replace it)")
+    drive, sig = load_measured(dataset)
+    veh = vehicle if vehicle is not None else drive.vehicle
+    vp = load_vehicle(veh)
+    timing = {}
+    calib = held = None
+
+    progress(f"dataset {drive.name}: {sig.duration:.1f} s, {len(sig.channels)} channels, "
+             f"vehicle {vp.id}")
+    ctx = prepare(sig, veh, seed=seed, n_windows=n_windows)
+    model, calib, held, edges, bounds = ctx.model, ctx.calib, ctx.held, ctx.edges, ctx.bounds
+    cal_edges, simc, segs = ctx.cal_edges, ctx.sim_nominal, ctx.segs
+    timing["road_fit_s"] = ctx.road_fit_s
+    progress(f"road: {len(bounds) - 1} segment(s), Gq(n0) = "
+             + ", ".join(f"{g * 1e6:.3g}" for g in model.gq) + " x 1e-6 m^3, w = "
+             + ", ".join(f"{x:.2f}" for x in model.w) + " (calibration windows)")
+
+    # where: nominal over the whole record
+    t = _time.perf_counter()
+    T = sig.time.size / sig.fs
+    sim = Signals(sig.time, model.add_noise(simc, seed + 1), dict(sig.units), sig.speed,
+                  {"model": "nominal"})
+    loc = localize(sig, sim, segments=segs)
+    wheelbase = float(vp.axles[0].x - vp.axles[2].x) if len(vp.axles) >= 3 else None
+    tr = transmissibility(sig, sim)
+    fr = front_rear(sig, sim, wheelbase=wheelbase)
+    sh = distribution_shape(sig, sim)
+    timing["localization_s"] = _time.perf_counter() - t
+
+    # which
+    t = _time.perf_counter()
+    names = list(effects) if effects else (list(QUICK_EFFECTS) if quick else None)
+    cands = candidates(names)
+    kw = dict(n_seeds=3, n_null=4, grid=3, refine=3, pairs=False) if quick else \
+        dict(n_seeds=4, n_null=6, grid=4, refine=4, pairs=True, n_pair_candidates=2)
+    kw.update(settings or {})
+    fit, simulate = Fit(model), Simulate(model)
+    progress(f"ranking {len(cands)} candidate effect(s) on {len(calib)} calibration + "
+             f"{len(held)} held-out windows ({workers} worker(s))")
+    if workers and workers > 1:
+        with ProcessPoolExecutor(workers) as ex:
+            ranking = rank_effects(cands, fit, simulate, calib, held, seed=seed, executor=ex,
+                                   progress=progress, **kw)
+    else:
+        ranking = rank_effects(cands, fit, simulate, calib, held, seed=seed, progress=progress, **kw)
+    timing["ranking_s"] = _time.perf_counter() - t
+    timing["total_s"] = _time.perf_counter() - wall0
+
+    meta = {
+        "dataset": str(dataset), "dataset_name": drive.name, "vehicle": str(vp.id),
+        "duration_s": float(T), "channels": list(sig.channels),
+        "road_segments": [{"segment": s[0], "t_start_s": s[1], "t_end_s": s[2],
+                           "Gq_n0_m3": float(g), "w": float(wk), "nmin": ROAD_NMIN,
+                           "nmax": ROAD_NMAX}
+                          for s, g, wk in zip(segs, model.gq, model.w)],
+        "road_fit": "segment level and waviness from the nominal model on the calibration "
+                    "windows; level re-profiled per segment piece for every model and window",
+        "split": f"{n_windows} equal time windows; odd windows calibrate, even windows held out",
+        "calibration_windows_s": [list(map(float, e)) for e in cal_edges],
+        "heldout_windows_s": [[float(edges[i]), float(edges[i + 1])] for i in range(n_windows)
+                              if i % 2 == 1],
+        "noise_std": model.noise, "wheelbase_m": wheelbase, "quick": bool(quick), "seed": int(seed),
+        "workers": int(workers), "candidates": [c.name for c in cands],
+        "ranking_settings": {k: v for k, v in kw.items()},
+        "timing": {k: round(v, 2) for k, v in timing.items()},
+    }
+    write_report(out, localization=loc, transmissibility=tr, front_rear=fr, shape=sh,
+                 ranking=ranking, meta=meta, force=force)
+    summary = json.loads((out / "summary.json").read_text())
+    progress(f"verdict: {ranking.verdict} ({ranking.confidence}); {ranking.reason}")
+    progress(f"wrote {out} in {timing['total_s']:.0f} s")
+    return summary
+
+
+def diagnose_dataset(path, out, quick: bool = False, workers: int = 2) -> dict:
+    """Entry point for ``eroad reproduce``: :func:`diagnose` with defaults, replacing ``out``.
+
+    Returns
+    -------
+    dict
+        The summary (``summary.json``).
+    """
+    return diagnose(path, out, quick=quick, workers=workers, force=True)

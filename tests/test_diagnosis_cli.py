@@ -1,0 +1,99 @@
+"""``eroad diagnose`` end to end on the Exudyn truck (issue 7, items 1, 2 and 4).
+
+Fast tests use a 16 s synthetic drive, ``--quick`` and two candidate effects; the blind
+check over synthetic cases is marked ``slow`` (``pytest -m slow``).
+"""
+import json
+import subprocess
+import sys
+
+import pytest
+
+from eroad.cli import main
+
+#: summary fields that legitimately differ between two runs of the same diagnosis
+RUN_FIELDS = ("timing", "dataset", "workers")
+
+
+@pytest.fixture(scope="module")
+def short_drive(tmp_path_factory):
+    """A 16 s drive: nominal truck plus leaf-spring friction of 4 kN (seed 3)."""
+    from drives.synth import synth_command
+
+    out = tmp_path_factory.mktemp("diag") / "lf"
+    synth_command(scenario="null", seed=3, effects=["leaf_friction=4000"], duration=16.0, out=out)
+    return out
+
+
+def _strip(summary):
+    meta = dict(summary.get("meta", {}))
+    for k in RUN_FIELDS:
+        meta.pop(k, None)
+    return dict(summary, meta=meta)
+
+
+def test_same_summary_without_truth(short_drive, tmp_path):
+    """The diagnosis reads nothing from truth/: a copy without it gives the same summary.json
+    (all fields but the run's own timing, dataset path and worker count)."""
+    from drives.synth import copy_without_truth
+
+    blind = copy_without_truth(short_drive, tmp_path / "blind")
+    assert not (blind / "truth").exists()
+    args = ["diagnose", "--quick", "--effects", "leaf_friction,sensor", "--workers", "1"]
+    assert main(args + [str(short_drive), "--out", str(tmp_path / "a")]) == 0
+    assert main(args + [str(blind), "--out", str(tmp_path / "b")]) == 0
+    a = json.loads((tmp_path / "a" / "summary.json").read_text())
+    b = json.loads((tmp_path / "b" / "summary.json").read_text())
+    assert _strip(a) == _strip(b)
+    # the report is complete and names the friction the truth carries
+    for key in ("localization", "ranking", "verdict", "how_far", "transmissibility"):
+        assert key in a
+    assert a["verdict"] == "leaf_friction"
+    assert (tmp_path / "a" / "report.md").is_file()
+    assert (tmp_path / "a" / "figures" / "heatmap.png").is_file()
+    # an existing run is not overwritten without --force
+    proc = subprocess.run([sys.executable, "-m", "eroad.cli"] + args
+                          + [str(blind), "--out", str(tmp_path / "b")], capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr and "--force" in proc.stderr
+
+
+def test_missing_dataset_is_one_line(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "eroad.cli", "diagnose", str(tmp_path / "nope"),
+                           "--out", str(tmp_path / "run")], capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "run").exists()
+
+
+def test_road_fit_recovers_waviness(short_drive):
+    """The cheap road fit recovers the truth's level and waviness of the one-segment road.
+
+    Tolerance: the level within a factor 1.5 and w within 0.25 (16 s, calibration half of
+    the record; the residual is the sampling error of the band powers and the friction
+    the nominal model lacks)."""
+    from diagnosis.pipeline import load_measured, prepare
+    from drives.synth import read_truth
+
+    drive, sig = load_measured(short_drive)
+    ctx = prepare(sig, drive.vehicle)
+    truth = read_truth(short_drive)["segments"]
+    t_mid = 0.5 * (ctx.bounds[:-1] + ctx.bounds[1:])
+    for k, tm in enumerate(t_mid):
+        seg = next(s for s in truth if s["t_start"] <= tm < s["t_end"])
+        assert abs(ctx.model.w[k] - seg["w"]) < 0.25
+        assert 1 / 1.5 < ctx.model.gq[k] / seg["Gq_n0"] < 1.5
+
+
+@pytest.mark.slow
+def test_blind_cases(tmp_path):
+    """Blind check (issue 7, item 2) on a small set: 5 cases (a null case, frame flexibility,
+    leaf friction, bump stops, damper asymmetry); every verdict right and none confidently
+    wrong.  The full 30-case run is ``benchmarks/bench_diagnosis.py``."""
+    from diagnosis.blind import run_blind
+
+    out = run_blind(tmp_path, 5, seed=0, workers=2, progress=lambda m: None)
+    sc = out["score"]
+    assert sc["confident_wrong"] == 0
+    assert sc["top1_accuracy"] >= 0.8

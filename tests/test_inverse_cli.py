@@ -1,0 +1,69 @@
+"""``eroad invert`` (inverse.cli): run folder contents, blindness to truth/, bad input."""
+import json
+import shutil
+
+import pytest
+
+from drives.synth import copy_without_truth, synth_command
+from eroad.cli import main
+from inverse.cli import run_inversion
+
+
+@pytest.fixture(scope="module")
+def short_drive(tmp_path_factory):
+    """An 8 s random drive (seed 5) and its copy without truth/."""
+    root = tmp_path_factory.mktemp("invert")
+    ds = root / "ds"
+    synth_command(scenario="random", seed=5, duration=8.0, out=ds)
+    blind = copy_without_truth(ds, root / "blind")
+    return ds, blind, root
+
+
+def _run(ds, out):
+    # K fixed, 2 iterations, 2 candidate realisations, serial: a smoke-size inversion
+    return run_inversion(ds, out, segments=2, workers=1, seed=0, max_iter=2, candidates=2)
+
+
+def test_invert_writes_the_run_and_ignores_truth(short_drive):
+    """The run folder holds summary/config/provenance, Tables 1-2, Figures 6/8/9 and the
+    road; the copy without truth/ gives the same segments, Table 2 and selection
+    (nothing is read from truth/; timings excluded)."""
+    ds, blind, root = short_drive
+    a = _run(ds, root / "run_a")
+    b = _run(blind, root / "run_b")
+    for key in ("segments", "table2", "errors", "road"):
+        assert a[key] == b[key], key
+    assert a["selection"]["candidates"] == b["selection"]["candidates"]
+    run = root / "run_a"
+    for f in ("summary.json", "config.toml", "run.json", "history.json", "road.npz", "road.crg",
+              "tables/table1.csv", "tables/table1.md", "tables/table2.csv", "tables/table2.md",
+              "figures/figure6_segmentation.png", "figures/figure8_time_compare.pdf",
+              "figures/figure9_amplitude_distributions.png"):
+        assert (run / f).is_file(), f
+    s = json.loads((run / "summary.json").read_text())
+    assert len(s["segments"]) == 2
+    keys = {"t_start", "t_end", "proportion", "Gq_n0", "w", "nmin", "nmax", "dx", "dy", "class"}
+    assert all(keys <= set(seg) for seg in s["segments"])
+    assert sum(seg["proportion"] for seg in s["segments"]) == pytest.approx(1.0)
+    assert {"axle_acc_3L", "axle_acc_3R"} <= set(s["errors"])
+    assert s["selection"]["n_candidates"] == 3 and len(s["history"]) >= 2
+    assert json.loads((run / "run.json").read_text())["status"] == "complete"
+
+
+def test_bad_input_is_one_line(short_drive, tmp_path, capsys):
+    """Missing dataset, existing non-empty --out and a bad --segments: exit 2, one line,
+    nothing overwritten."""
+    ds, _, _ = short_drive
+    assert main(["invert", str(tmp_path / "nope"), "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("eroad: error:") and "\n" not in err
+    out = tmp_path / "taken"
+    out.mkdir()
+    (out / "mine.txt").write_text("keep")
+    assert main(["invert", str(ds), "--out", str(out)]) == 2
+    assert "not empty" in capsys.readouterr().err and (out / "mine.txt").read_text() == "keep"
+    assert main(["invert", str(ds), "--out", str(tmp_path / "r2"), "--segments", "0"]) == 2
+    assert "--segments" in capsys.readouterr().err
+    assert main(["invert", str(ds), "--out", str(tmp_path / "r3"), "--channels", "nope_1L"]) == 2
+    assert "--channels" in capsys.readouterr().err
+    assert not (tmp_path / "r2").exists() and not (tmp_path / "r3").exists()
