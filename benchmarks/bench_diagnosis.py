@@ -69,8 +69,9 @@ def main(argv=None) -> int:
     d = [r["diagnose_s"] for r in res]
     print(f"\ncases {sc['n_cases']}: top-1 {sc['top1_accuracy']:.2f} (effect cases "
           f"{sc['effect_top1_accuracy']:.2f}), null 'none' {sc['null_none_rate']:.2f}, "
-          f"confident wrong {sc['confident_wrong']}, localisation hits "
-          f"{sc['localisation_hit_rate']:.2f}, mean |pred - true shrink| {sc['shrink_mean_abs_diff']}")
+          f"confident wrong {sc['confident_wrong']}, localisation hits on effect cases "
+          f"{sc['localisation_hit_rate_effects']:.2f}, flagged cells on null cases "
+          f"{sc['null_flagged_cells']}, mean |pred - true shrink| {sc['shrink_mean_abs_diff']}")
     print(f"diagnosis wall time: mean {sum(d) / len(d):.1f} s, max {max(d):.1f} s "
           f"({sum(d) / len(d) / ref:.0f} x the reference simulation); whole run {wall:.0f} s")
     Path(args.out, "timing.json").write_text(json.dumps(

@@ -56,7 +56,7 @@ ACTS = {
     "tyre_enveloping": (("axle_acc", "body_acc", "susp_disp"), 4.0, 56.0),
 }
 #: the ranking budget of the blind run (the whole library, no pairs)
-BLIND_SETTINGS = dict(n_seeds=3, n_null=4, grid=4, refine=3, pairs=False)
+BLIND_SETTINGS = dict(n_seeds=4, n_null=8, grid=4, refine=3, pairs=False)
 
 
 def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None) -> list[dict]:
@@ -155,6 +155,7 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
     # scoring only from here: truth is read
     truth = read_truth(ds)
     truth_eff = truth["vehicle"]["truth"]["effects"]
+    case = dict(case, seed=int(truth.get("seed", case["seed"])))   # the seed actually used
     verdict = summ["verdict"]
     entry = next((e for e in summ.get("ranking", []) if e["effect"] == verdict), None)
     pred_shrink = float(entry["shrink_fraction"]) if entry else 0.0
@@ -202,6 +203,9 @@ def score(results: list[dict]) -> dict:
         "confident_wrong": int(sum(r["confident_wrong"] for r in results)),
         "localisation_hit_rate": float(np.mean([r["localisation_hit"] for r in results]))
         if results else float("nan"),
+        "localisation_hit_rate_effects": float(np.mean([r["localisation_hit"] for r in eff]))
+        if eff else float("nan"),
+        "null_flagged_cells": [int(r["n_flagged"]) for r in nul],
         "shrink_pred_vs_true": [[float(a), float(b)] for a, b in pairs],
         "shrink_mean_abs_diff": float(np.mean([abs(a - b) for a, b in pairs])) if pairs else None,
         "labels": labels,

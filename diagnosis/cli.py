@@ -25,6 +25,10 @@ def register(subparsers) -> None:
     p.add_argument("--workers", type=int, default=2, metavar="N",
                    help="processes for the candidate calibrations (default 2)")
     p.add_argument("--seed", type=int, default=0, help="root seed of the road phases (default 0)")
+    p.add_argument("--road-fit", choices=("levels", "inverse"), default="levels",
+                   help="road identification: 'levels' (default: segment level and waviness "
+                   "from the nominal model on the calibration windows, seconds) or 'inverse' "
+                   "(the full inverse fit of the whole record, Gq, w, nmin, nmax; about a minute)")
     p.add_argument("--quick", action="store_true",
                    help="smoke-test settings: 4 candidates, fewer seeds, shorter search, no pairs")
     p.add_argument("--json", action="store_true", help="print summary.json's verdict part as JSON")
@@ -44,7 +48,7 @@ def run(args) -> int:
     progress = (lambda msg: print(msg, file=sys.stderr, flush=True)) if args.json else None
     kw = {"progress": progress} if progress else {}
     summary = diagnose(args.dataset, args.out, vehicle=args.vehicle, effects=effects,
-                       workers=args.workers, quick=args.quick, force=args.force, seed=args.seed, **kw)
+                       workers=args.workers, quick=args.quick, force=args.force, seed=args.seed, road_fit=args.road_fit, **kw)
     if args.json:
         best = summary["ranking"][0] if summary.get("ranking") else None
         print(json.dumps({"verdict": summary["verdict"],

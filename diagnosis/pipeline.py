@@ -10,16 +10,18 @@ Road identification (the cheap road fit, decision)
 -------------------------------------------------
 The full inverse fit (``inverse.pipeline.invert``) costs minutes per model; the
 ranking needs one road fit per candidate and per calibration evaluation (about 150).
-The diagnosis therefore keeps the road *shape* fixed (``w = 2``, ``nmin = 0.1``,
-``nmax = 5`` cycles/m, the ISO 8608 defaults) and identifies the *level* ``Gq(n0)``
-per segment:
+The diagnosis therefore keeps ``nmin = 0.1``, ``nmax = 5`` cycles/m (the ISO 8608
+defaults) and identifies level ``Gq(n0)`` and waviness ``w`` per segment
+(:func:`fit_road`):
 
 1. Segments: :func:`inverse.segmentation.segment` on the suspension displacements
    (level-based change points, BIC for K).
-2. Nominal level, once: one simulation over the whole record on a class-C reference
-   road; per segment ``Gq = Gq_ref * mean_c(P_meas,c / P_sim,c)`` over the channels
-   (geometric mean) on the CALIBRATION samples of the segment only.  Exact for a
-   linear model (response power scales with ``Gq``).
+2. Nominal road, once: one simulation over the whole record on a class-C reference
+   road (``w = 2``); per segment, on its CALIBRATION samples, the log ratio of measured
+   to simulated third-octave band power (1-12 Hz, suspension and axle channels) is
+   regressed on ``ln(f / (v n0))``: slope ``2 - w``, exact for a linear model.  A
+   second simulation with the fitted ``w`` sets the level (geometric mean of the
+   channel power ratios; response power scales with ``Gq``).
 3. For each model (nominal or with an effect) and each simulated window, the road
    level is re-profiled per segment piece: the simulated piece is scaled by
    ``sqrt(mean_c P_meas / P_sim)`` (geometric mean over channels, smooth 0.5 s
@@ -27,6 +29,8 @@ per segment:
    identified on the data with the effect fixed) at the cost of no extra
    simulation; exact for a linear model, first order for the nonlinear effects
    (friction, bump stop, damper asymmetry), which see the level of step 2.
+   The waviness is not refitted per model: an effect that tilts the suspension and
+   axle spectra is partly absorbed by the nominal ``w``.
 
 Sensor noise: the measured record carries white sensor noise the simulation lacks.
 Its level per channel is estimated from the measured spectrum between 0.6 and 0.95 of
@@ -161,6 +165,8 @@ class TruckModel:
         Road level per segment (``GQ_REF`` before the level fit).
     w : (K,) array, optional
         Road waviness per segment (default ``ROAD_W``).
+    nmin, nmax : (K,) arrays, optional
+        Road band per segment [cycles/m] (default ``ROAD_NMIN``, ``ROAD_NMAX``).
     noise : dict channel -> std
         White sensor noise added to simulations.
     channels : list of str
@@ -178,6 +184,8 @@ class TruckModel:
     channels: list
     ref_axle: int = 3
     w: np.ndarray | None = None
+    nmin: np.ndarray | None = None
+    nmax: np.ndarray | None = None
     _roads: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __getstate__(self):
@@ -220,7 +228,8 @@ class TruckModel:
 
         wv = np.full(len(gq), ROAD_W) if self.w is None else np.asarray(self.w, float)
         key = (round(t0, 6), round(t1, 6), int(seed), tuple(np.round(np.log(gq), 9)),
-               tuple(np.round(wv, 9)))
+               tuple(np.round(wv, 9)), None if self.nmin is None else tuple(self.nmin),
+               None if self.nmax is None else tuple(self.nmax))
         if key in self._roads:
             return self._roads[key]
         tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1)
@@ -231,8 +240,10 @@ class TruckModel:
         for k in range(len(gq)):
             L = edges[k + 1] - edges[k]
             if L > 2 * ROAD_DX:
-                segs.append(RoadSegment(Gq_n0=float(gq[k]), share=float(L), w=float(wv[k]),
-                                        nmin=ROAD_NMIN, nmax=ROAD_NMAX, lam=1.0))
+                segs.append(RoadSegment(
+                    Gq_n0=float(gq[k]), share=float(L), w=float(wv[k]),
+                    nmin=float(ROAD_NMIN if self.nmin is None else self.nmin[k]),
+                    nmax=float(ROAD_NMAX if self.nmax is None else self.nmax[k]), lam=1.0))
                 k_used.append(k)
         road = segmented_surface(segs, float(sum(s_.share for s_ in segs)), ROAD_WIDTH, ROAD_DX,
                                  ROAD_DY, seed=int(seed))
@@ -557,17 +568,61 @@ class Context:
     road_fit_s: float
 
 
-def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4) -> Context:
-    """Segments, noise, calibration/held-out windows, nominal road levels, and the nominal
-    simulation of the whole record (road-phase seed ``seed + 1``, noise-free)."""
+def inverse_road(sig: Signals, vehicle, workers: int = 2):
+    """The full inverse fit (``inverse.pipeline.invert`` with ``inverse.truck``) of the whole
+    record: boundaries [s] and per-segment (Gq_n0, w, nmin, nmax)."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from inverse.pipeline import InversionConfig, invert
+    from inverse.sensitivity import FitConfig
+    from inverse.truck import TruckSimulator, truck_predict_rms
+
+    chans = dict(sig.channels)
+
+    def make(t_bounds):
+        return TruckSimulator(str(vehicle), sig.time, sig.speed, t_bounds, list(chans))
+
+    cfg = InversionConfig(fit=FitConfig(n_workers=1))
+    if workers > 1:
+        with ProcessPoolExecutor(workers) as pool:
+            inv = invert(sig.time, chans, sig.speed, make, predict_rms=truck_predict_rms(str(vehicle)),
+                         config=cfg, map_fn=pool.map)
+    else:
+        inv = invert(sig.time, chans, sig.speed, make, predict_rms=truck_predict_rms(str(vehicle)),
+                     config=cfg)
+    rows = inv.segments()
+    b = np.asarray(inv.t_bounds, float)
+    b[0], b[-1] = 0.0, sig.time.size / sig.fs
+    par = np.array([[r["Gq_n0"], r["w"], r["nmin"], r["nmax"]] for r in rows], float)
+    return b, par
+
+
+def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fit: str = "levels",
+            workers: int = 2) -> Context:
+    """Segments, noise, calibration/held-out windows, nominal road, and the nominal
+    simulation of the whole record (road-phase seed ``seed + 1``, noise-free).
+
+    ``road_fit``: ``"levels"`` (default, :func:`fit_road` on the calibration windows) or
+    ``"inverse"`` (:func:`inverse_road`, the full inverse fit of the whole record, used
+    as it is; the held-out windows then take part in the road fit, which the per-window
+    re-levelling of the ranking does anyway).
+    """
     t = _time.perf_counter()
-    bounds = road_segments(sig)
     noise = noise_std(sig, list(sig.channels))
-    model = TruckModel(vehicle, sig.time, sig.speed, bounds, np.full(len(bounds) - 1, GQ_REF), noise,
-                       list(sig.channels))
     calib, held, edges = windows(sig, n_windows)
     cal_edges = [(float(edges[i]), float(edges[i + 1])) for i in range(n_windows) if i % 2 == 0]
-    model.gq, model.w = fit_road(model, sig, cal_edges, seed)
+    if road_fit == "inverse":
+        bounds, par = inverse_road(sig, vehicle, workers)
+        model = TruckModel(vehicle, sig.time, sig.speed, bounds, par[:, 0].copy(), noise,
+                           list(sig.channels), w=par[:, 1].copy(), nmin=par[:, 2].copy(),
+                           nmax=par[:, 3].copy())
+    elif road_fit == "levels":
+        bounds = road_segments(sig)
+        model = TruckModel(vehicle, sig.time, sig.speed, bounds, np.full(len(bounds) - 1, GQ_REF),
+                           noise, list(sig.channels))
+        model.gq, model.w = fit_road(model, sig, cal_edges, seed)
+    else:
+        raise EroadInputError(f"road_fit must be 'levels' or 'inverse', got {road_fit!r}")
     T = sig.time.size / sig.fs
     simc = model.run({}, 0.0, T, seed + 1)
     model.noise = noise_from_residual(sig, simc)
@@ -600,7 +655,7 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
 
 def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quick: bool = False,
              force: bool = False, seed: int = 0, n_windows: int = 4, settings=None,
-             progress=_say) -> dict:
+             road_fit: str = "levels", progress=_say) -> dict:
     """Diagnose a measured dataset against the nominal truck and write the report.
 
     Parameters
@@ -624,6 +679,9 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         Root seed of all road phases.
     n_windows : int
         Alternating windows (odd calibrate, even held out).
+    road_fit : {"levels", "inverse"}
+        The cheap road fit (default) or the full inverse fit of the whole record
+        (``inverse.pipeline.invert`` on the Exudyn truck; segments, Gq, w, nmin, nmax).
     settings : dict, optional
         Overrides of the ``rank_effects`` budget (``n_seeds``, ``n_null``, ``grid``,
         ``refine``, ``pairs``, ...).
@@ -653,7 +711,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
 
     progress(f"dataset {drive.name}: {sig.duration:.1f} s, {len(sig.channels)} channels, "
              f"vehicle {vp.id}")
-    ctx = prepare(sig, veh, seed=seed, n_windows=n_windows)
+    ctx = prepare(sig, veh, seed=seed, n_windows=n_windows, road_fit=road_fit, workers=workers)
     model, calib, held, edges, bounds = ctx.model, ctx.calib, ctx.held, ctx.edges, ctx.bounds
     cal_edges, simc, segs = ctx.cal_edges, ctx.sim_nominal, ctx.segs
     timing["road_fit_s"] = ctx.road_fit_s
@@ -678,7 +736,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     names = list(effects) if effects else (list(QUICK_EFFECTS) if quick else None)
     cands = candidates(names)
     kw = dict(n_seeds=3, n_null=4, grid=3, refine=3, pairs=False) if quick else \
-        dict(n_seeds=4, n_null=6, grid=4, refine=4, pairs=True, n_pair_candidates=2)
+        dict(n_seeds=4, n_null=8, grid=4, refine=4, pairs=True, n_pair_candidates=2)
     kw.update(settings or {})
     fit, simulate = Fit(model), Simulate(model)
     progress(f"ranking {len(cands)} candidate effect(s) on {len(calib)} calibration + "
@@ -696,11 +754,14 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         "dataset": str(dataset), "dataset_name": drive.name, "vehicle": str(vp.id),
         "duration_s": float(T), "channels": list(sig.channels),
         "road_segments": [{"segment": s[0], "t_start_s": s[1], "t_end_s": s[2],
-                           "Gq_n0_m3": float(g), "w": float(wk), "nmin": ROAD_NMIN,
-                           "nmax": ROAD_NMAX}
-                          for s, g, wk in zip(segs, model.gq, model.w)],
-        "road_fit": "segment level and waviness from the nominal model on the calibration "
-                    "windows; level re-profiled per segment piece for every model and window",
+                           "Gq_n0_m3": float(model.gq[k]), "w": float(model.w[k]),
+                           "nmin": float(ROAD_NMIN if model.nmin is None else model.nmin[k]),
+                           "nmax": float(ROAD_NMAX if model.nmax is None else model.nmax[k])}
+                          for k, s in enumerate(segs)],
+        "road_fit": ("segment level and waviness from the nominal model on the calibration "
+                     "windows" if road_fit == "levels" else
+                     "inverse.pipeline.invert on the whole record (nominal truck)")
+        + "; level re-profiled per segment piece for every model and window",
         "split": f"{n_windows} equal time windows; odd windows calibrate, even windows held out",
         "calibration_windows_s": [list(map(float, e)) for e in cal_edges],
         "heldout_windows_s": [[float(edges[i]), float(edges[i + 1])] for i in range(n_windows)
