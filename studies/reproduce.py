@@ -14,7 +14,7 @@ step        paper items                             code
 ==========  ======================================  ==========================================
 dataset     (input)                                 drives.synth.default_dataset
 fig4_5      Figures 4, 5                            drives.figures.plot_figures
-invert      Figures 6, 8, 9; Tables 1, 2; road      inverse.cli.invert_dataset
+invert      Figures 6, 8, 9; Tables 1, 2; road      inverse.cli.run_inversion
 figure11    Figure 11 and the findings table        studies.figure11.run_figure11
 chassis     chassis-stiffness study                 studies.chassis_study.run_chassis_study
 diagnose    sim-to-real gap of the dataset          diagnosis.pipeline.diagnose_dataset
@@ -40,12 +40,12 @@ from eroad.errors import EroadInputError
 MANIFEST = [
     ("Figure 4", "fig4_5", "figure4_displacement.png", "drives.figures.plot_figures"),
     ("Figure 5", "fig4_5", "figure5_spectrum.png", "drives.figures.plot_figures"),
-    ("Figure 6", "invert", "figures/figure6_segmentation.png", "inverse.cli.invert_dataset"),
-    ("Table 1", "invert", "table1.md", "inverse.cli.invert_dataset"),
-    ("Figure 8", "invert", "figures/figure8_time.png", "inverse.cli.invert_dataset"),
-    ("Figure 9", "invert", "figures/figure9_amplitude.png", "inverse.cli.invert_dataset"),
-    ("Table 2", "invert", "table2.md", "inverse.cli.invert_dataset"),
-    ("Global road (section 2.5)", "invert", "road.npz", "inverse.cli.invert_dataset"),
+    ("Figure 6", "invert", "figures/figure6_segmentation.png", "inverse.cli.run_inversion"),
+    ("Table 1", "invert", "table1.md", "inverse.cli.run_inversion"),
+    ("Figure 8", "invert", "figures/figure8_time.png", "inverse.cli.run_inversion"),
+    ("Figure 9", "invert", "figures/figure9_amplitude.png", "inverse.cli.run_inversion"),
+    ("Table 2", "invert", "table2.md", "inverse.cli.run_inversion"),
+    ("Global road (section 2.5)", "invert", "road.npz", "inverse.cli.run_inversion"),
     ("Figure 11", "figure11", "figures/figure11.png", "studies.figure11.run_figure11"),
     ("Findings of section 5 (true/false)", "figure11", "data/findings.md",
      "studies.figure11.run_figure11"),
@@ -79,10 +79,10 @@ def _step_fig4_5(run: Path, quick: bool, workers: int, log) -> dict:
 
 
 def _step_invert(run: Path, quick: bool, workers: int, log) -> dict:
-    from inverse.cli import invert_dataset
+    from inverse.cli import run_inversion
 
-    return _jsonable(invert_dataset(run / "dataset", run / "invert", quick=quick,
-                                    workers=workers, seed=0))
+    return _jsonable(run_inversion(run / "dataset", run / "invert", quick=quick,
+                                   workers=workers, seed=0, argv=sys.argv))
 
 
 def _identified_road(run: Path) -> Path:
