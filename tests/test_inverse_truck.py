@@ -104,3 +104,17 @@ def test_predict_rms_scales_with_sqrt_gq():
     assert b / a == pytest.approx(2.0, rel=1e-9)
     assert 1e-3 < a < 2e-2
     pickle.dumps(pr)
+
+
+def test_join_sides_keeps_each_track():
+    """The per-side road: tracks outside the 0.3 m centre strip are exactly the left
+    road's (y > 0) and the right road's (y < 0); the seed pair reaches the simulator's road."""
+    from inverse.truck import join_sides
+    a = road_from_params(P2, [40.0, 60.0], seed=1, width=3.0)
+    b = road_from_params(P2, [40.0, 60.0], seed=2, width=3.0)
+    j = join_sides(a, b)
+    left, right = np.flatnonzero(a.y >= 0.3), np.flatnonzero(a.y <= -0.3)
+    assert np.array_equal(j.z[:, left], a.z[:, left]) and np.array_equal(j.z[:, right], b.z[:, right])
+    sim = _sim()
+    r = sim.road(P2, (1, 2))
+    assert r.meta["seed_left"] != r.meta["seed_right"]
