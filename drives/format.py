@@ -86,7 +86,7 @@ class Quantity:
 QUANTITIES: dict[str, Quantity] = {
     "susp_disp": Quantity("m", 0.5, "looks like millimetres; convert to metres",
                           "suspension displacement, axle relative to body, + compression"),
-    "axle_acc": Quantity("m/s^2", 200.0, "looks like millimetres (mm/s^2); convert to m/s^2",
+    "axle_acc": Quantity("m/s^2", 1000.0, "looks like millimetres (mm/s^2); convert to m/s^2",
                          "vertical acceleration at the axle end, + up, gravity removed"),
     "body_acc": Quantity("m/s^2", 200.0, "looks like millimetres (mm/s^2); convert to m/s^2",
                          "vertical body acceleration above the axle end, + up, gravity removed"),
