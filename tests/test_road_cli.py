@@ -8,10 +8,8 @@ import pytest
 from eroad.cli import main
 from roadlib.surface import RoadSurface
 
-PROFILE = Path("/work/shared/data/iri/profile_1.txt")
-_here = Path(__file__).resolve().parents[2] / "shared" / "data" / "iri" / "profile_1.txt"
-if _here.exists():
-    PROFILE = _here
+#: copy of ../shared/data/iri/profile_1.txt (provenance: tests/data/iri/PROVENANCE.md)
+PROFILE = Path(__file__).resolve().parent / "data" / "iri" / "profile_1.txt"
 
 
 def _run(capsys, *argv):

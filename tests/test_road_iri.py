@@ -12,9 +12,8 @@ import pytest
 from eroad.errors import EroadInputError
 from roadlib.iri import iri, iri_segments
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "iri" / "profile_1.txt"
-if not DATA.exists():
-    DATA = Path("/work/shared/data/iri/profile_1.txt")
+#: copy of ../shared/data/iri/profile_1.txt kept beside the tests (provenance: tests/data/iri/PROVENANCE.md)
+DATA = Path(__file__).resolve().parent / "data" / "iri" / "profile_1.txt"
 REFERENCE = [(478, 578, 3.2985), (578, 678, 2.4421), (678, 778, 3.5551), (778, 878, 4.0855),
              (878, 978, 2.7079)]
 
