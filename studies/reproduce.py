@@ -247,7 +247,34 @@ def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False
         if target.exists():
             target.rmdir()  # empty (checked above)
         tmp.rename(target)
+        _repoint(target, tmp, target)
     return summary
+
+
+def _repoint(folder: Path, old: Path, new: Path, max_bytes: int = 20_000_000) -> int:
+    """Replace the temporary run path by the final one in the run's text records.
+
+    Steps record the paths they were given (the dataset, their output); those pointed
+    into the temporary folder, which no longer exists once it is renamed into place.
+
+    Returns
+    -------
+    int
+        Number of files rewritten.
+    """
+    old_s, new_s = str(old.resolve()), str(new.resolve())
+    n = 0
+    for path in folder.rglob("*"):
+        if path.suffix not in (".json", ".md", ".toml", ".txt") or not path.is_file() \
+                or path.stat().st_size > max_bytes:
+            continue
+        text = path.read_text(encoding="utf-8")
+        if old_s in text:
+            tmp_file = path.with_name(path.name + ".repoint")
+            tmp_file.write_text(text.replace(old_s, new_s), encoding="utf-8")
+            tmp_file.replace(path)
+            n += 1
+    return n
 
 
 def register(subparsers) -> None:

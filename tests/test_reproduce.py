@@ -41,3 +41,13 @@ def test_quick_reproduce_produces_every_paper_item(tmp_path):
     assert run["status"] == "complete"
     # nothing of the synthetic truth is copied into the run
     assert not (out / "dataset" / "truth").exists()
+
+
+def test_recorded_paths_point_into_the_final_folder(tmp_path):
+    """Steps record the dataset path they were given; after the temporary run folder is
+    renamed into place, those records must name the final folder, not the vanished one."""
+    out = tmp_path / "run"
+    assert main(["reproduce", "--out", str(out), "--steps", "dataset,fig4_5", "--json"]) == 0
+    texts = [p.read_text() for p in out.rglob("*.json")]
+    assert not any(".run.tmp-" in t for t in texts)
+    assert any(str(out.resolve()) in t for t in texts)
