@@ -10,15 +10,13 @@ figures.  What it is not: it never simulates, and it never reads ``truth/``.
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
 from scipy.signal import welch
 
-from drives.format import Drive, read_drive, temp_folder_beside
+from drives.format import Drive, read_drive, swap_into_place, temp_folder_beside
 from eroad.errors import EroadInputError
 
 #: Welch segment length [s]: 0.2 Hz resolution, enough averages in a 10 s window
@@ -168,13 +166,7 @@ def figures_command(dataset, out, *, window=None, channel="susp_disp_3L", force=
     try:
         summary = plot_figures(drive, tmp, window=window, channel=channel)
         (tmp / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-        if out.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
-            os.replace(out, old / "d")
-            os.replace(tmp, out)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, out)
+        swap_into_place(tmp, out)
     finally:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)

@@ -783,6 +783,28 @@ def _umask() -> int:
     return mask
 
 
+def swap_into_place(tmp: Path, target: Path) -> None:
+    """Rename the complete folder ``tmp`` to ``target``.
+
+    An empty ``target`` is removed first; a non-empty one (the caller has checked that
+    overwriting is wanted) is first moved aside under a hidden name in the same
+    directory and removed only after ``tmp`` is in place, so a failure in between
+    never loses both.
+    """
+    tmp, target = Path(tmp), Path(target)
+    if target.exists():
+        if target.is_dir() and not any(target.iterdir()):
+            target.rmdir()
+            os.replace(tmp, target)
+        else:
+            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
+            os.replace(target, old / "d")
+            os.replace(tmp, target)
+            shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(tmp, target)
+
+
 def temp_folder_beside(target) -> Path:
     """A new temporary folder in the parent of ``target`` (for write-then-rename).
 
@@ -885,17 +907,7 @@ def write_drive(folder, frame: pd.DataFrame, meta: dict, *, vehicle_file=None,
         if problems:
             first = problems[0].replace(str(tmp), str(folder))
             raise EroadInputError(f"not written: {first}")
-        if folder.exists():
-            if folder.is_dir() and not any(folder.iterdir()):
-                folder.rmdir()
-                os.replace(tmp, folder)
-            else:  # overwrite: move the old one aside, then remove it
-                old = Path(tempfile.mkdtemp(prefix=f".{folder.name}.old-", dir=parent))
-                os.replace(folder, old / "d")
-                os.replace(tmp, folder)
-                shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, folder)
+        swap_into_place(tmp, folder)
     finally:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
