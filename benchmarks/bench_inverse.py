@@ -30,6 +30,34 @@ from pathlib import Path
 import numpy as np
 
 
+def oracle_fits(dataset: Path, truth: dict, track_y=(-0.9, 0.9)) -> list:
+    """The statistical floor: each true segment's (Gq_n0, w) fitted to the TRUE road.
+
+    The road under the wheels (both wheel tracks of ``truth/road.npz`` between the
+    segment's x_start and x_end), one full-length Hann periodogram per track,
+    Whittle fit (:func:`roadlib.metrics.fit_iso_psd`) over the segment's own true
+    band [nmin, nmax].  No response-based method can know more about a segment's
+    spectrum than the exact profile it drove over, so these errors bound what the
+    inversion can reach on the same segments.
+    """
+    from roadlib.metrics import fit_iso_psd, profile_psd
+    from roadlib.surface import RoadSurface
+
+    road = RoadSurface.load(Path(dataset) / "truth" / "road.npz")
+    out = []
+    for s in truth["segments"]:
+        x = np.arange(s["x_start"], s["x_end"], road.dx)
+        if x.size < 64:
+            out.append(None)
+            continue
+        z = road.tracks(list(track_y), x).T
+        est = profile_psd(z, road.dx, nperseg=x.size)
+        fit = fit_iso_psd(est, band=(s["nmin"], s["nmax"]))
+        out.append({"Gq": float(fit.Gd_n0), "w": float(fit.w),
+                    "dlnGq": abs(math.log(fit.Gd_n0 / s["Gq_n0"])), "dw": abs(fit.w - s["w"])})
+    return out
+
+
 def score_case(truth: dict, summary: dict) -> dict:
     """Per-segment errors of one inversion against its truth."""
     from inverse.pipeline import segment_errors
@@ -69,6 +97,15 @@ def table(cases: list) -> str:
         lines.append(f"| {name} | {len(rs)} | {np.median(g):.3f} | {g.max():.3f} | "
                      f"{100 * np.mean(g <= math.log(1.2)):.0f}% | {np.median(w):.3f} | {w.max():.3f} | "
                      f"{100 * np.mean(w <= 0.15):.0f}% | {100 * cl:.0f}% | {b} |")
+        orc = [r["oracle"] for r in rs if r.get("oracle")]
+        if orc:
+            from roadlib.psd import class_of
+            go = np.array([o["dlnGq"] for o in orc])
+            wo = np.array([o["dw"] for o in orc])
+            clo = np.mean([class_of(o["Gq"]) == r["class_true"] for r, o in zip(rs, orc)])
+            lines.append(f"| {name}, true-road oracle | {len(orc)} | {np.median(go):.3f} | {go.max():.3f} | "
+                         f"{100 * np.mean(go <= math.log(1.2)):.0f}% | {np.median(wo):.3f} | {wo.max():.3f} | "
+                         f"{100 * np.mean(wo <= 0.15):.0f}% | {100 * clo:.0f}% | |")
     kr = np.mean([c["K_true"] == c["K_fit"] for c in cases])
     lines.append(f"\n{len(cases)} cases, K right in {100 * kr:.0f}%, median wall "
                  f"{np.median([c['wall_s'] for c in cases]):.1f} s per inversion")
@@ -83,6 +120,14 @@ def main(argv=None) -> int:
     ap.add_argument("--max-iter", type=int, default=10)
     ap.add_argument("--channels", default="axle3")
     ap.add_argument("--root", default="/tmp/eroad-bench-inverse")
+    ap.add_argument("--data-root", default=None,
+                    help="where the synthetic datasets are made or found (default: ROOT); share "
+                         "it between runs that compare settings on the same drives")
+    ap.add_argument("--no-polish", action="store_true", help="switch off the fit's polishing step")
+    ap.add_argument("--scenario", default="random", choices=["random", "null"],
+                    help="random: the truth has leaf friction and a flexible frame the nominal "
+                         "model lacks; null: the truth vehicle IS the nominal model (the method's "
+                         "accuracy alone, with the finer step, finer road grid and sensor noise)")
     ap.add_argument("--no-default-effects", action="store_true",
                     help="truth vehicle without the scenario's leaf friction (no model gap but the "
                          "flexible frame and the finer step): the method's accuracy alone")
@@ -93,6 +138,8 @@ def main(argv=None) -> int:
 
     root = Path(a.root)
     root.mkdir(parents=True, exist_ok=True)
+    data_root = Path(a.data_root) if a.data_root else root
+    data_root.mkdir(parents=True, exist_ok=True)
     res_file = root / "results.jsonl"
     done = {}
     if res_file.is_file():
@@ -105,10 +152,10 @@ def main(argv=None) -> int:
         if seed in done:
             seed += 1
             continue
-        ds = root / f"random-{seed}"
+        ds = data_root / f"{a.scenario}-{seed}"
         try:
             if not (ds / "truth" / "summary.json").is_file():
-                synth_command(scenario="random", seed=seed, out=ds, force=True,
+                synth_command(scenario=a.scenario, seed=seed, out=ds, force=True,
                               default_effects=not a.no_default_effects)
         except EroadInputError as exc:   # e.g. a class E road overloads a sensor range
             case = {"seed": seed, "skipped": str(exc)}
@@ -118,13 +165,17 @@ def main(argv=None) -> int:
             print(f"seed {seed}: skipped ({exc})", flush=True)
             seed += 1
             continue
-        blind = root / f"blind-{seed}"
+        blind = data_root / f"blind-{a.scenario}-{seed}"
         if not blind.exists():
             copy_without_truth(ds, blind)
         t0 = time.perf_counter()
         summ = run_inversion(blind, root / f"run-{seed}", workers=a.workers, seed=0, candidates=0,
-                             max_iter=a.max_iter, channels=a.channels, force=True)
-        case = score_case(read_truth(ds), summ)
+                             max_iter=a.max_iter, channels=a.channels, force=True,
+                             polish=not a.no_polish)
+        truth = read_truth(ds)
+        case = score_case(truth, summ)
+        for r, o in zip(case["segments"], oracle_fits(ds, truth)):
+            r["oracle"] = o
         case.update(seed=seed, wall_s=time.perf_counter() - t0)
         with res_file.open("a") as f:
             f.write(json.dumps(case) + "\n")

@@ -118,7 +118,7 @@ def _check_out(out: Path, force: bool) -> None:
 
 def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 0, quick: bool = False,
                   force: bool = False, candidates=None, max_iter=None, effects=None, chassis: str = "rigid",
-                  channels="axle3", argv=None) -> dict:
+                  channels="axle3", argv=None, polish: bool = True) -> dict:
     """Invert a dataset into the run folder ``out`` (see the module docstring).
 
     Parameters
@@ -146,6 +146,10 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         Fitted (and simulated) channels: 'axle3' (default), 'all' or names.
     argv : list of str, optional
         Command line recorded in run.json.
+    polish : bool
+        The fit's final polishing step over several road realisations
+        (:class:`inverse.sensitivity.FitConfig` ``polish_replicates``); off only to
+        compare.
 
     Returns
     -------
@@ -183,7 +187,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     time = np.asarray(drive.time, float)
     chans = {c: drive.channels[c].to_numpy(float) for c in fit_channels(drive.channel_names, channels)}
     speed = np.asarray(drive.speed, float)
-    fit_cfg = FitConfig(max_iter=iters, n_workers=1)
+    fit_cfg = FitConfig(max_iter=iters, n_workers=1, **({} if polish else {"polish_replicates": 0}))
     bounds = ParamBounds(nmax=(1.0, nmax_cap(SIM_DX)))
     icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed)
     make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans))

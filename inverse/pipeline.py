@@ -122,7 +122,8 @@ class Inversion:
         """JSON-ready summary: segments, fit statistics, iteration history."""
         return {"segments": self.segments(),
                 "fit": {"n_sims": self.fit.n_sims, "wall_s": self.fit.wall_s,
-                        "iterations": len(self.fit.history) - 1,
+                        "iterations": sum(h.get("kind") == "trust_region" for h in self.fit.history[1:]),
+                        "polished": any(h.get("kind") == "polish" for h in self.fit.history),
                         "objective": float(self.fit.history[-1]["objective"]),
                         "n_features": int(self.features.n_features().sum())},
                 "segmentation": {"criterion": {str(k): float(v) for k, v in self.segmentation.criterion.items()}},

@@ -103,6 +103,16 @@ class FitConfig:
         Posterior / prior variance above which a parameter is not identifiable.
     n_workers : int
         Processes for sampling when no ``map_fn`` is given (1 = serial).
+    polish_replicates : int
+        Road realisations (other seeds) simulated at the converged point for the
+        final polishing step; 0 switches it off.  The trust-region iterations see
+        ONE simulated realisation, so they match the measured features to that
+        realisation's scatter as well as to the parameters; the polish averages the
+        log features over 1 + R realisations at the converged point and takes one
+        bounded Gauss-Newton step with the last sampled Jacobians (valid because,
+        with common random numbers, the Jacobian hardly depends on the
+        realisation).  It divides the simulation side's share of the parameter
+        variance by 1 + R for R + 1 simulations.
     """
 
     scale: tuple = (1.0, 0.25, 0.5, 0.3)
@@ -119,6 +129,7 @@ class FitConfig:
     prior_sigma: tuple = (math.log(4.0), 0.5, 1.0, 0.5)
     id_ratio: float = 0.25
     n_workers: int = 1
+    polish_replicates: int = 4
 
 
 @dataclass
@@ -176,7 +187,8 @@ class FitResult:
     theta : ndarray, shape (K, 4)
     segments : list of SegmentFit
     history : list of dict
-        One entry per iteration (iteration 0 = initial point): 'iter', 'theta',
+        One entry per iteration (iteration 0 = initial point): 'iter', 'kind'
+        ('trust_region', or 'polish' for the final averaged step), 'theta',
         'params' (lists, the iterate after the iteration), 'objective' (data
         misfit + prior term, summed over segments), 'objective_segments',
         'radius', 'rho', 'accepted', 'identifiable', 'converged',
@@ -279,6 +291,12 @@ class _TrustRegionQP:
         return np.clip(d, lbd, ubd), stats.get("return_status", "")
 
 
+def _apply(job):
+    """``job = (evaluator, params)`` -> evaluator(params); for maps over several seeds."""
+    ev, params = job
+    return ev(params)
+
+
 def _prior_objective(theta, prior, pw):
     return np.sum(pw * (theta - prior) ** 2, axis=1)
 
@@ -298,6 +316,36 @@ def _design(theta, H, lo, hi):
             th[:, i] = target
             out.append(th)
     return out
+
+
+def polish_seeds(seed: int, replicates: int) -> list:
+    """Seeds of the polishing realisations: SeedSequence(seed, spawn_key=(1000 + r,))."""
+    return [int(np.random.SeedSequence(seed, spawn_key=(1000 + r,)).generate_state(1)[0])
+            for r in range(replicates)]
+
+
+def _polish(theta, Fc, J, y, W, evaluator, features, seed, config, qp, prior_theta, pw, ident,
+            radius, lo, hi, map_fn, objective):
+    """The final averaged Gauss-Newton step (see ``FitConfig.polish_replicates``)."""
+    K = theta.shape[0]
+    scale = np.asarray(config.scale, dtype=float)
+    evs = [_Evaluator(evaluator.simulate, features, s, evaluator.features_fn)
+           for s in polish_seeds(seed, config.polish_replicates)]
+    params = theta_to_params(theta)
+    extra = list(map_fn(_apply, [(ev, params) for ev in evs]))
+    Fbar = [np.mean([Fc[k]] + [F[k] for F in extra], axis=0) for k in range(K)]
+    Q = [J[k].T @ (W[k][:, None] * J[k]) for k in range(K)]
+    b = np.array([J[k].T @ (W[k] * (y[k] - Fbar[k])) for k in range(K)])
+    box = np.maximum(radius, 0.5)[:, None] * scale
+    lbd = np.maximum(-box, lo - theta)
+    ubd = np.minimum(box, hi - theta)
+    lbd[~ident] = 0.0
+    ubd[~ident] = 0.0
+    d, _ = qp.solve(Q, b, theta, prior_theta, pw, lbd, ubd)
+    new = theta + d
+    # the kept realisation (the fit's seed) at the polished point, for the report
+    Fn = list(map_fn(_apply, [(evaluator, theta_to_params(new))]))[0]
+    return new, Fn, objective(Fn, new)
 
 
 def check_common_random_numbers(simulate, params, seed: int = 0, steps=(0.1, 0.025, 0.1, 0.1)) -> dict:
@@ -420,9 +468,10 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
         ident = np.ones((K, P), dtype=bool)
         sd = np.full((K, P), np.nan)
         svals = [[] for _ in range(K)]
+        J_last = [None] * K
 
-        def record(it, rho, accepted, status=""):
-            entry = {"iter": it, "solver_status": status, "theta": theta.tolist(), "params": theta_to_params(theta).tolist(),
+        def record(it, rho, accepted, status="", kind="trust_region"):
+            entry = {"iter": it, "kind": kind, "solver_status": status, "theta": theta.tolist(), "params": theta_to_params(theta).tolist(),
                      "objective": float(obj_c.sum()), "objective_segments": obj_c.tolist(),
                      "radius": radius.tolist(), "rho": rho, "accepted": accepted,
                      "identifiable": ident.tolist(), "converged": converged.tolist(),
@@ -441,6 +490,7 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
                 D = np.array([s[k] - theta[k] for s in samples])  # (S, P)
                 R = np.array([F[k] - Fc[k] for F in Fs])  # (S, m)
                 J = np.linalg.lstsq(D, R, rcond=None)[0].T  # (m, P)
+                J_last[k] = J
                 Qk = J.T @ (W[k][:, None] * J)
                 # identifiability in prior-scaled coordinates
                 G = psig[:, None] * Qk * psig[None, :]
@@ -495,6 +545,11 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
             record(it, rho, accepted, status)
             if converged.all():
                 break
+        if config.polish_replicates > 0 and all(J is not None for J in J_last):
+            theta, Fc, obj_c = _polish(theta, Fc, J_last, y, W, evaluator, features, seed, config,
+                                       qp, prior_theta, pw, ident, radius, lo, hi, map_fn, objective)
+            n_sims += (config.polish_replicates + 1) * len(evaluator.seeds)
+            record(len(history), [None] * K, [True] * K, kind="polish")
     finally:
         if pool is not None:
             pool.shutdown()
