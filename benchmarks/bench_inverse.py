@@ -124,6 +124,9 @@ def main(argv=None) -> int:
                     help="where the synthetic datasets are made or found (default: ROOT); share "
                          "it between runs that compare settings on the same drives")
     ap.add_argument("--no-polish", action="store_true", help="switch off the fit's polishing step")
+    ap.add_argument("--known-noise", action="store_true",
+                    help="give the inversion the sensor-noise levels (a data-sheet value a user "
+                         "would know; read from truth/ noise, nothing else of the truth)")
     ap.add_argument("--scenario", default="random", choices=["random", "null"],
                     help="random: the truth has leaf friction and a flexible frame the nominal "
                          "model lacks; null: the truth vehicle IS the nominal model (the method's "
@@ -168,10 +171,18 @@ def main(argv=None) -> int:
         blind = data_root / f"blind-{a.scenario}-{seed}"
         if not blind.exists():
             copy_without_truth(ds, blind)
+        noise = None
+        if a.known_noise:
+            nz = read_truth(ds)["noise"]
+            fs = float(read_truth(ds)["record"]["sample_rate_hz"])
+            noise = {f"{q}_{st}": nz[key] ** 2 / (fs / 2)
+                     for q, key in (("susp_disp", "susp_disp_m"), ("axle_acc", "axle_acc_mps2"),
+                                    ("body_acc", "body_acc_mps2"))
+                     for st in ("1L", "1R", "2L", "2R", "3L", "3R", "4L", "4R", "L", "R")}
         t0 = time.perf_counter()
         summ = run_inversion(blind, root / f"run-{seed}", workers=a.workers, seed=0, candidates=0,
                              max_iter=a.max_iter, channels=a.channels, force=True,
-                             polish=not a.no_polish)
+                             polish=not a.no_polish, noise_psd=noise)
         truth = read_truth(ds)
         case = score_case(truth, summ)
         for r, o in zip(case["segments"], oracle_fits(ds, truth)):

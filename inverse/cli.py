@@ -118,7 +118,7 @@ def _check_out(out: Path, force: bool) -> None:
 
 def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 0, quick: bool = False,
                   force: bool = False, candidates=None, max_iter=None, effects=None, chassis: str = "rigid",
-                  channels="axle3", argv=None, polish: bool = True) -> dict:
+                  channels="axle3", argv=None, polish: bool = True, noise_psd=None) -> dict:
     """Invert a dataset into the run folder ``out`` (see the module docstring).
 
     Parameters
@@ -146,6 +146,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         Fitted (and simulated) channels: 'axle3' (default), 'all' or names.
     argv : list of str, optional
         Command line recorded in run.json.
+    noise_psd : dict, optional
+        Channel -> known white sensor-noise PSD [unit^2/Hz] (else estimated).
     polish : bool
         The fit's final polishing step over several road realisations
         (:class:`inverse.sensitivity.FitConfig` ``polish_replicates``); off only to
@@ -189,7 +191,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     speed = np.asarray(drive.speed, float)
     fit_cfg = FitConfig(max_iter=iters, n_workers=1, **({} if polish else {"polish_replicates": 0}))
     bounds = ParamBounds(nmax=(1.0, nmax_cap(SIM_DX)))
-    icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed)
+    icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd)
     make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans))
     predict = TruckPredictRms(drive.vehicle, ("susp_disp_3L", "susp_disp_3R"), chassis=chassis, effects=effects)
 

@@ -64,6 +64,10 @@ class InversionConfig:
         Table 1.
     seed : int
         Root seed (see module docstring).
+    noise_psd : dict, optional
+        Channel -> known white sensor-noise PSD [unit^2/Hz] (e.g. from the data
+        sheet: sd^2 / (fs / 2)); channels not given are estimated from the top
+        of their spectrum (:func:`inverse.features.estimate_noise_psd`).
     """
 
     k: int | None = None
@@ -78,6 +82,7 @@ class InversionConfig:
     nmin_prior: float = 0.05
     nmax_prior: float = 5.0
     seed: int = 0
+    noise_psd: dict | None = None
 
 
 @dataclass
@@ -177,7 +182,7 @@ def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
     if spec is None:
         names = sorted(c for c in channels if c.split("_")[0] in ("susp", "axle", "body"))
         spec = FeatureSpec(channels=tuple(names))
-    feats = FeatureSet.from_measurement(t, channels, seg.t_bounds, spec)
+    feats = FeatureSet.from_measurement(t, channels, seg.t_bounds, spec, noise_psd=config.noise_psd)
     K = seg.n_segments
     Gq0 = np.where(np.isfinite(seg.Gq_init), seg.Gq_init, 256e-6)
     params0 = np.column_stack([Gq0, np.full(K, config.w0), np.full(K, config.nmin0), np.full(K, config.nmax0)])
