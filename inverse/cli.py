@@ -22,7 +22,6 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import math
-import os
 import platform
 import shutil
 import sys
@@ -220,10 +219,11 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             pool.shutdown()
 
     t1 = _time.perf_counter()
-    tmp = out.parent / f".{out.name}.tmp-{os.getpid()}"
-    if tmp.exists():
-        shutil.rmtree(tmp)
-    (tmp / "tables").mkdir(parents=True)
+    from drives.format import swap_into_place, temp_folder_beside
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = temp_folder_beside(out)
+    (tmp / "tables").mkdir()
     try:
         simulated = sel["simulated"]
         rows = response_table(chans, simulated, table_ch)
@@ -282,9 +282,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             "git": git_state(), "versions": package_versions(), "host": platform.node(),
             "started": started.isoformat(), "finished": _dt.datetime.now(_dt.timezone.utc).isoformat(),
             "status": "complete", "wall_s": timing["total_s"]})
-        if out.exists():
-            shutil.rmtree(out)
-        os.replace(tmp, out)
+        swap_into_place(tmp, out)   # an old RUN (--force) is removed only once the new one is in place
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
