@@ -56,6 +56,10 @@ def register(subparsers) -> None:
                         "channel), or a comma list")
     p.add_argument("--effect", action="append", default=[], metavar="NAME[.PARAM]=VALUE",
                    help="effect added to the nominal model (repeatable), e.g. leaf_friction")
+    p.add_argument("--noise", action="append", default=[], metavar="NAME=SD",
+                   help="known white sensor noise, standard deviation in the channel's SI unit, for a "
+                        "channel (susp_disp_3L=1e-4) or a quantity (axle_acc=0.03); repeatable; channels "
+                        "not given are estimated from the top of their spectrum")
     p.add_argument("--quick", action="store_true", help="few iterations and candidates (smoke runs)")
     p.add_argument("--json", action="store_true", help="print summary.json to stdout")
     p.add_argument("--force", action="store_true", help="replace an existing RUN")
@@ -66,7 +70,7 @@ def _cmd_invert(args) -> int:
     summary = run_inversion(args.dataset, args.out, segments=args.segments, workers=args.workers,
                             seed=args.seed, quick=args.quick, force=args.force, candidates=args.candidates,
                             max_iter=args.max_iter, channels=args.channels, effects=_effects(args.effect),
-                            argv=sys.argv)
+                            noise_sd=_noise(args.noise), argv=sys.argv)
     if args.json:
         print(json.dumps(summary, indent=2))
     else:
@@ -77,6 +81,40 @@ def _cmd_invert(args) -> int:
                           if c in t2)
               + f" ({summary['timing']['total_s']:.1f} s wall)")
     return 0
+
+
+def _noise(items) -> dict | None:
+    """``["axle_acc=0.03", ...]`` -> {"axle_acc": 0.03}; one clear line on a bad item."""
+    out = {}
+    for item in items:
+        name, sep, val = item.partition("=")
+        try:
+            sd = float(val) if sep else float("nan")
+        except ValueError:
+            sd = float("nan")
+        if not name.strip() or not (sd > 0 and math.isfinite(sd)):
+            raise EroadInputError(f"--noise {item!r}: expected NAME=SD with SD a positive number in the "
+                                  f"channel's SI unit, e.g. axle_acc=0.03")
+        out[name.strip()] = sd
+    return out or None
+
+
+def noise_psd_from_sd(noise_sd: dict, channels, fs: float, src: str = "--noise") -> dict:
+    """White-noise PSDs [unit^2/Hz] = sd^2 / (fs / 2) per channel from sd per channel or quantity.
+
+    A key matches a channel by its full name or by its quantity (the name without the
+    station suffix, e.g. ``axle_acc`` for ``axle_acc_3L``); a key that matches no
+    channel is refused.
+    """
+    out = {}
+    for key, sd in noise_sd.items():
+        hit = [c for c in channels if c == key or c.rsplit("_", 1)[0] == key]
+        if not hit:
+            raise EroadInputError(f"{src} {key}: matches no channel of the drive "
+                                  f"({', '.join(sorted(channels))})")
+        for c in hit:
+            out[c] = float(sd) ** 2 / (0.5 * fs)
+    return out
 
 
 def _effects(items):
@@ -117,7 +155,7 @@ def _check_out(out: Path, force: bool) -> None:
 
 def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 0, quick: bool = False,
                   force: bool = False, candidates=None, max_iter=None, effects=None, chassis: str = "rigid",
-                  channels="axle3", argv=None, polish: bool = True, noise_psd=None) -> dict:
+                  channels="axle3", argv=None, polish: bool = True, noise_sd=None) -> dict:
     """Invert a dataset into the run folder ``out`` (see the module docstring).
 
     Parameters
@@ -145,8 +183,9 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         Fitted (and simulated) channels: 'axle3' (default), 'all' or names.
     argv : list of str, optional
         Command line recorded in run.json.
-    noise_psd : dict, optional
-        Channel -> known white sensor-noise PSD [unit^2/Hz] (else estimated).
+    noise_sd : dict, optional
+        Known white sensor noise: channel or quantity (``axle_acc``) -> standard
+        deviation [SI unit of the channel]; the rest is estimated.
     polish : bool
         The fit's final polishing step over several road realisations
         (:class:`inverse.sensitivity.FitConfig` ``polish_replicates``); off only to
@@ -190,6 +229,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     speed = np.asarray(drive.speed, float)
     fit_cfg = FitConfig(max_iter=iters, n_workers=1, **({} if polish else {"polish_replicates": 0}))
     bounds = ParamBounds(nmax=(1.0, nmax_cap(SIM_DX)))
+    fs = 1.0 / float(np.median(np.diff(time)))
+    noise_psd = noise_psd_from_sd(noise_sd, list(drive.channel_names), fs) if noise_sd else None
     icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd)
     make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans))
     predict = TruckPredictRms(drive.vehicle, ("susp_disp_3L", "susp_disp_3R"), chassis=chassis, effects=effects)
@@ -272,6 +313,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         write_json_atomic(tmp / "summary.json", summary)
         import tomli_w
         cfg = {"dataset": str(Path(dataset).resolve()), "segments": segments if segments is not None else "auto",
+               "noise_sd": dict(noise_sd or {}), "polish": bool(polish),
                "workers": workers, "seed": seed, "quick": quick, "candidates": n_cand, "max_iter": iters,
                "chassis": chassis, "channels": list(chans), "effects": json.dumps(effects or {}),
                "simulator": {"dx_m": SIM_DX, "nmax_cap_cpm": nmax_cap(SIM_DX)},

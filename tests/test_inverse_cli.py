@@ -95,3 +95,19 @@ def test_blind_benchmark_no_model_gap(tmp_path, capsys):
     if segs:
         assert np.median([r["dlnGq"] for r in segs]) < math.log(2.0)
         assert np.median([r["dw"] for r in segs]) < 0.3
+
+
+def test_noise_option_parsing_and_psd():
+    """--noise NAME=SD: sd in SI units -> white PSD sd^2 / (fs/2) per matching channel;
+    a bad value or a name matching no channel is one clear error."""
+    from eroad.errors import EroadInputError
+    from inverse.cli import _noise, noise_psd_from_sd
+
+    sd = _noise(["axle_acc=0.03", "susp_disp_3L=1e-4"])
+    psd = noise_psd_from_sd(sd, ["axle_acc_3L", "axle_acc_3R", "susp_disp_3L", "susp_disp_3R"], fs=200.0)
+    assert psd == pytest.approx({"axle_acc_3L": 9e-6, "axle_acc_3R": 9e-6, "susp_disp_3L": 1e-10})
+    for bad in (["axle_acc=abc"], ["axle_acc=-1"], ["=0.1"], ["axle_acc"]):
+        with pytest.raises(EroadInputError, match="NAME=SD"):
+            _noise(bad)
+    with pytest.raises(EroadInputError, match="matches no channel"):
+        noise_psd_from_sd({"wheel": 0.1}, ["axle_acc_3L"], fs=200.0)
