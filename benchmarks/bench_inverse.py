@@ -74,7 +74,12 @@ def score_case(truth: dict, summary: dict) -> dict:
         rows.append({"duration_s": s["t_end"] - s["t_start"], "Gq_true": s["Gq_n0"], "Gq_fit": f["Gq_n0"],
                      "w_true": s["w"], "w_fit": f["w"], "dlnGq": abs(math.log(f["Gq_n0"] / s["Gq_n0"])),
                      "dw": abs(f["w"] - s["w"]), "class_true": class_of(s["Gq_n0"]),
-                     "class_fit": class_of(f["Gq_n0"])})
+                     "class_fit": class_of(f["Gq_n0"]),
+                     # the PSD at 1 cycle/m (~10 Hz at 10 m/s, where the truck responds)
+                     "dlnG_1cpm": abs(math.log(f["Gq_n0"] / s["Gq_n0"]) - (f["w"] - s["w"]) * math.log(10.0)),
+                     **({"n_best": f["n_best"], "sd_ln_G_n_best": f["sd_ln_G_n_best"],
+                         "dlnG_n_best": abs(math.log(f["G_n_best"] / (s["Gq_n0"] * (f["n_best"] / 0.1) ** -s["w"])))}
+                        if "n_best" in f else {})})
     berr = segment_errors(tt, tf)
     return {"segments": rows, "boundary_err_s": [float(b) for b in np.abs(berr)],
             "K_true": len(tsegs), "K_fit": len(fit)}
@@ -106,6 +111,20 @@ def table(cases: list) -> str:
             lines.append(f"| {name}, true-road oracle | {len(orc)} | {np.median(go):.3f} | {go.max():.3f} | "
                          f"{100 * np.mean(go <= math.log(1.2)):.0f}% | {np.median(wo):.3f} | {wo.max():.3f} | "
                          f"{100 * np.mean(wo <= 0.15):.0f}% | {100 * clo:.0f}% | |")
+    lines.append("\nThe fitted PSD where the truck sees the road (segments >= 3 s):")
+    rs = [r for r in segs if r["duration_s"] >= 3.0]
+    g1 = np.array([r["dlnG_1cpm"] for r in rs if "dlnG_1cpm" in r])
+    if g1.size:
+        lines.append(f"* at 1 cycle/m: median abs ln error {np.median(g1):.3f}, within 20% in "
+                     f"{100 * np.mean(g1 <= math.log(1.2)):.0f}% of {g1.size}")
+    gb = [r for r in rs if "dlnG_n_best" in r]
+    if gb:
+        e = np.array([r["dlnG_n_best"] for r in gb])
+        z = e / np.array([r["sd_ln_G_n_best"] for r in gb])
+        nb = np.array([r["n_best"] for r in gb])
+        lines.append(f"* at each segment's n_best (median {np.median(nb):.2f} cycles/m): median abs ln error "
+                     f"{np.median(e):.3f}, within 20% in {100 * np.mean(e <= math.log(1.2)):.0f}%; "
+                     f"error / reported sd: median {np.median(z):.2f} (0.67 if the sd is right)")
     kr = np.mean([c["K_true"] == c["K_fit"] for c in cases])
     lines.append(f"\n{len(cases)} cases, K right in {100 * kr:.0f}%, median wall "
                  f"{np.median([c['wall_s'] for c in cases]):.1f} s per inversion")

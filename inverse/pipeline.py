@@ -108,7 +108,9 @@ class Inversion:
         list of dict
             t_start, t_end [s], proportion [-], Gq_n0 [m^3], w [-], nmin, nmax
             [cycles/m], dx, dy [m], class, initial_class, identifiable, sd,
-            objective, n_features, converged.
+            objective, n_features, converged, and where the level is best
+            determined: n_best [cycles/m], G_n_best [m^3], sd_ln_G_n_best [-]
+            (:func:`inverse.sensitivity.best_level`).
         """
         rows = []
         tb = self.t_bounds
@@ -120,7 +122,8 @@ class Inversion:
                          "dx": d["dx"], "dy": d["dy"], "class": d["class"],
                          "initial_class": self.segmentation.classes[k],
                          "identifiable": d["identifiable"], "sd": d["sd"], "objective": d["objective"],
-                         "n_features": d["n_features"], "converged": d["converged"]})
+                         "n_features": d["n_features"], "converged": d["converged"],
+                         **{key: d[key] for key in ("n_best", "G_n_best", "sd_ln_G_n_best") if key in d}})
         return rows
 
     def summary(self) -> dict:

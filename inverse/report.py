@@ -28,7 +28,9 @@ def table1(segments: list) -> pd.DataFrame:
     -------
     DataFrame
         segment, t_start, t_end [s], proportion [%], class, Gq_n0 [1e-6 m^3], w,
-        nmin, nmax [cycles/m], dx, dy [m], not identifiable (names).
+        nmin, nmax [cycles/m], dx, dy [m], not identifiable (names), and where
+        present the best-determined level (n_best [cycles/m], G_n_best
+        [1e-6 m^3], sd of ln G there) with the sd of ln Gq_n0 for comparison.
     """
     rows = []
     for i, s in enumerate(segments):
@@ -38,7 +40,10 @@ def table1(segments: list) -> pd.DataFrame:
                      "proportion_pct": round(100 * s["proportion"], 2), "class": s["class"],
                      "Gq_n0_1e-6m3": round(1e6 * s["Gq_n0"], 2), "w": round(s["w"], 3),
                      "nmin_cpm": round(s["nmin"], 4), "nmax_cpm": round(s["nmax"], 3),
-                     "dx_m": s["dx"], "dy_m": s["dy"], "not_identifiable": " ".join(held)})
+                     "dx_m": s["dx"], "dy_m": s["dy"], "not_identifiable": " ".join(held),
+                     **({"n_best_cpm": round(s["n_best"], 3), "G_n_best_1e-6m3": round(1e6 * s["G_n_best"], 4),
+                         "sd_ln_G_n_best": round(s["sd_ln_G_n_best"], 3), "sd_ln_Gq_n0": round(s["sd"]["ln_Gq_n0"], 3)}
+                        if "n_best" in s else {})})
     return pd.DataFrame(rows)
 
 

@@ -65,7 +65,7 @@ import numpy as np
 
 from eroad.errors import EroadInputError, SimulationError
 from inverse.features import FeatureSet
-from inverse.spectral import (PARAM_NAMES, THETA_NAMES, ParamBounds, grid_spacing, iso_class,
+from inverse.spectral import (N0, PARAM_NAMES, THETA_NAMES, ParamBounds, grid_spacing, iso_class,
                               params_to_theta, theta_to_params)
 
 P = 4  # parameters per segment
@@ -155,6 +155,13 @@ class SegmentFit:
         Weighted feature misfit at the fit [-].
     n_features : int
     converged : bool
+    best_level : dict
+        Where the data pin the road level best: ``n_best`` [cycles/m], the
+        spatial frequency at which the Laplace variance of ln Gd(n) = ln Gq_n0
+        - w ln(n / n0) is smallest (ln(n_best / n0) = cov(ln Gq, w) / var(w),
+        kept inside [nmin, nmax]), ``G_n_best`` [m^3] the fitted Gd there and
+        ``sd_ln_G_n_best`` its standard deviation [-].  Gq_n0 itself is an
+        extrapolation along w from about there.
     """
 
     params: dict
@@ -167,13 +174,35 @@ class SegmentFit:
     objective: float
     n_features: int
     converged: bool
+    best_level: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         """JSON-ready dict."""
         return {**self.params, "class": self.cls, "dx": self.dx, "dy": self.dy,
                 "identifiable": self.identifiable, "sd": self.sd,
                 "singular_values": self.singular_values, "objective": self.objective,
-                "n_features": self.n_features, "converged": self.converged}
+                "n_features": self.n_features, "converged": self.converged, **self.best_level}
+
+
+def best_level(params: dict, cov: np.ndarray, n0: float = N0) -> dict:
+    """The best-determined road level of a segment (see ``SegmentFit.best_level``).
+
+    Parameters
+    ----------
+    params : dict
+        Gq_n0 [m^3], w [-], nmin, nmax [cycles/m].
+    cov : (4, 4) array
+        Laplace covariance of (ln Gq_n0, w, ln nmin, ln nmax).
+    n0 : float
+        Reference spatial frequency [cycles/m].
+    """
+    c11, c12, c22 = float(cov[0, 0]), float(cov[0, 1]), float(cov[1, 1])
+    L = c12 / c22 if c22 > 0 and np.isfinite(c12 / c22) else 0.0
+    L = float(np.clip(L, math.log(params["nmin"] / n0), math.log(params["nmax"] / n0)))
+    var = max(c11 - 2 * L * c12 + L * L * c22, 0.0)
+    n_best = n0 * math.exp(L)
+    return {"n_best": n_best, "G_n_best": params["Gq_n0"] * (n_best / n0) ** (-params["w"]),
+            "sd_ln_G_n_best": math.sqrt(var)}
 
 
 @dataclass
@@ -467,6 +496,7 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
         converged = np.zeros(K, dtype=bool)
         ident = np.ones((K, P), dtype=bool)
         sd = np.full((K, P), np.nan)
+        cov = np.full((K, P, P), np.nan)
         svals = [[] for _ in range(K)]
         J_last = [None] * K
 
@@ -497,7 +527,8 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
                 post = np.linalg.inv(G + np.eye(P))
                 ident[k] = np.diag(post) <= config.id_ratio
                 svals[k] = np.sqrt(np.maximum(np.linalg.eigvalsh(G)[::-1], 0.0)).tolist()
-                sd[k] = np.sqrt(np.diag(np.linalg.inv(Qk + np.diag(pw[k]))))
+                cov[k] = np.linalg.inv(Qk + np.diag(pw[k]))
+                sd[k] = np.sqrt(np.diag(cov[k]))
                 Q.append(Qk)
                 bvec[k] = J.T @ (W[k] * (y[k] - Fc[k]))
             # step bounds: trust region, parameter bounds, held parameters, converged segments
@@ -564,5 +595,6 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
             params=pk, cls=iso_class(pk["Gq_n0"]), dx=dx, dy=dx,
             identifiable=dict(zip(PARAM_NAMES, map(bool, ident[k]))),
             sd=dict(zip(THETA_NAMES, map(float, sd[k]))), singular_values=svals[k],
-            objective=float(obj_data[k]), n_features=int(nf[k]), converged=bool(converged[k])))
+            objective=float(obj_data[k]), n_features=int(nf[k]), converged=bool(converged[k]),
+            best_level=best_level(pk, cov[k]) if np.all(np.isfinite(cov[k])) else {}))
     return FitResult(params, theta, segs, history, n_sims, _time.perf_counter() - t_start, Fc)

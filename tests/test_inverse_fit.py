@@ -175,3 +175,23 @@ def test_polish_removes_most_of_the_simulated_realisations_scatter():
         spread[polish] = np.std(lnq, ddof=1)
     print(spread)
     assert spread[4] * 1.5 < spread[0], spread
+
+
+def test_best_level_closed_form_and_on_a_fit(recovery):
+    """ln Gd(n) = ln Gq_n0 - w ln(n/n0) has variance C11 - 2 L C12 + L^2 C22, smallest at
+    L = C12 / C22: with C11 0.1, C12 0.06, C22 0.04, L = 1.5 (n_best = 0.1 e^1.5 =
+    0.448 cycles/m) and sd sqrt(0.01) = 0.1.  On the quarter-truck fit the level at
+    n_best is better determined than Gq_n0 and lies inside the band."""
+    from inverse.sensitivity import best_level
+
+    cov = np.zeros((4, 4))
+    cov[:2, :2] = [[0.1, 0.06], [0.06, 0.04]]
+    b = best_level({"Gq_n0": 1e-4, "w": 2.0, "nmin": 0.01, "nmax": 10.0}, cov)
+    assert b["n_best"] == pytest.approx(0.1 * math.exp(1.5))
+    assert b["sd_ln_G_n_best"] == pytest.approx(0.1)
+    assert b["G_n_best"] == pytest.approx(1e-4 * math.exp(-3.0))
+    d, fset, sim, bounds, res = recovery
+    for s in res.segments:
+        row = s.as_dict()
+        assert row["nmin"] <= row["n_best"] <= row["nmax"]
+        assert row["sd_ln_G_n_best"] < s.sd["ln_Gq_n0"]
