@@ -37,16 +37,23 @@ from pathlib import Path
 
 import numpy as np
 
-#: truth strength per effect: (parameter, lo, hi, log, random sign of the change)
+#: truth strength per effect: (parameter, lo, hi, log, random sign of the change).
+#: Rule (docs/diagnosis.md, "Blind strengths"): the weak end is where the effect first
+#: changes some third-octave band of one channel quantity by 3 standard errors of a 30 s
+#: drive (:func:`effect_size`, median over the quantity's channels, null-scenario roads
+#: seeds 500 and 501, mean of the two); the strong end is the largest physically plausible
+#: model error.  speed_scale changes no response band: its weak end is 2 % (about 5 standard
+#: errors of the front-to-rear delay of a 30 s drive at steady speed), its strong end 10 %
+#: (UN R39 allows a speedometer 10 % + 4 km/h high).
 STRENGTHS = {
-    "frame_flex": ("stiffness_factor", 0.3, 3.0, True, False),
-    "leaf_friction": ("force", 1500.0, 6000.0, False, False),
-    "bump_stop": ("gap", 0.01, 0.025, False, False),
-    "damper_asymmetry": ("ratio", 2.5, 5.0, False, False),
-    "payload": ("mass", 3000.0, 8000.0, False, True),
-    "speed_scale": ("factor", 0.06, 0.12, False, True),     # |factor - 1|
-    "sensor": ("cutoff", 6.0, 20.0, True, False),
-    "tyre_enveloping": ("length", 0.25, 0.5, False, False),
+    "frame_flex": ("stiffness_factor", 0.3, 30.0, True, False),    # size 5-12; 100: 2.0
+    "leaf_friction": ("force", 500.0, 6000.0, True, False),        # 250 N: 2.9, 500 N: 8.1
+    "bump_stop": ("gap", 0.005, 0.02, False, False),               # 0.02 m: 4.0, 0.03 m: 2.8
+    "damper_asymmetry": ("ratio", 2.0, 5.0, False, False),         # 1.5: 1.4, 2.0: 3.3
+    "payload": ("mass", 7000.0, 12000.0, False, True),             # +6 t: 2.6, +9 t: 3.6, -6 t: 3.7
+    "speed_scale": ("factor", 0.02, 0.10, False, True),            # |factor - 1|
+    "sensor": ("cutoff", 6.0, 50.0, True, False),                  # 45 Hz: 8.5, 60 Hz: 1.9
+    "tyre_enveloping": ("length", 0.15, 0.5, False, False),        # every length >= 0.05 m: > 3
 }
 #: where each effect acts: (channel quantities, band lo, band hi [Hz]) for the localisation score
 ACTS = {
@@ -266,3 +273,71 @@ def run_blind(root, n: int = 30, *, seed: int = 0, workers: int = 2, duration=No
     sc = score(results)
     (root / "confusion.txt").write_text(format_confusion(sc) + "\n")
     return {"results": results, "score": sc}
+
+
+def effect_size(effect: str, param: str, value: float, seed: int, *, duration: float = 30.0,
+                extra: dict | None = None) -> dict:
+    """How much one effect at one strength changes a 30 s drive, in standard errors.
+
+    The ``null`` scenario drive of ``seed`` (road, speed, sensor noise levels) is simulated
+    with the nominal truck and with the effect, on the SAME road and with the same noise
+    realisation (so the difference is the effect only).  Per channel and third-octave band
+    (0.5-50 Hz, whole record) ``d = ln(P_effect / P_nominal)``; its yardstick is the
+    standard error of the log band-power difference of two INDEPENDENT 30 s drives,
+    ``se = sqrt(2 trigamma(nu / 2))`` (``nu`` the band EDOF).  Per channel quantity
+    (susp_disp, axle_acc, body_acc) and band the median over the quantity's channels of
+    ``|d| / se`` is taken (one odd channel does not count); the effect size is the
+    largest of these.
+
+    ``extra``: other parameters of the effect (e.g. the sensor's noise switched off, to size
+    the low-pass alone).
+
+    Returns
+    -------
+    dict with ``size`` (max median |d|/se), ``quantity`` and ``band_hz`` where it occurs.
+    """
+    from drives.synth import build_road, load_scenario, plan_drive, resolve_scenario
+    from vehicles.params import load_vehicle
+    from vehicles.simulate import SpeedProfile, simulate
+
+    from diagnosis.bandpower import band_powers, var_log_power
+
+    cfg, path = load_scenario("null")
+    cfg = resolve_scenario(cfg, seed, duration=duration, src=path)
+    vp = load_vehicle(cfg["scenario"]["vehicle"])
+    plan = plan_drive(cfg, [float(a.x) for a in vp.axles])
+    road = build_road(cfg, plan)
+    fs = float(cfg["scenario"]["sample_rate_hz"])
+    n_run, n_rec = plan["n_runin"], plan["n_record"]
+    noise = cfg["noise"]
+    eff = {} if effect == "none" else {effect: {param: float(value), **(extra or {})}}
+    out = []
+    for e in ({}, eff):
+        res = simulate(vp, road, speed=SpeedProfile(plan["t_sim"], plan["v_sim"]),
+                       duration=(n_run + n_rec) / fs, fs_out=fs, x_start=plan["x_front0"],
+                       effects=e or None, seed=seed)
+        ch = {}
+        for k, c in enumerate(sorted(c for c in res.channels
+                                     if c.startswith(("susp_disp_", "axle_acc_", "body_acc_")))):
+            x = np.asarray(res.channels[c], float)[n_run:n_run + n_rec]
+            sd = noise["susp_disp_m"] if c.startswith("susp_disp_") else \
+                noise["axle_acc_mps2"] if c.startswith("axle_acc_") else noise["body_acc_mps2"]
+            rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(11, k)))
+            ch[c] = x + sd * rng.standard_normal(x.size)
+        out.append(ch)
+    names = list(out[0])
+    b0 = band_powers(np.array([out[0][c] for c in names]), fs)
+    b1 = band_powers(np.array([out[1][c] for c in names]), fs, nperseg=b0.nperseg)
+    with np.errstate(all="ignore"):
+        z = np.abs(np.log(b1.power / b0.power)) / np.sqrt(2.0 * var_log_power(b0.nu))
+    best = (0.0, None, None)
+    for q in ("susp_disp_", "axle_acc_", "body_acc_"):
+        rows = [i for i, c in enumerate(names) if c.startswith(q)]
+        with np.errstate(all="ignore"):
+            med = np.nanmedian(z[rows], axis=0)
+        if np.isfinite(med).any():
+            b = int(np.nanargmax(med))
+            if med[b] > best[0]:
+                best = (float(med[b]), q.rstrip("_"), [float(b0.bands[b, 0]), float(b0.bands[b, 2])])
+    return {"effect": effect, "param": param, "value": float(value), "seed": int(seed),
+            "size": best[0], "quantity": best[1], "band_hz": best[2]}

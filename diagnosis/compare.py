@@ -244,7 +244,7 @@ def transmissibility(measured, simulated, *, pairs: Sequence[tuple[str, str]] | 
 
 # ----------------------------------------------------------------------------- front to rear
 def gcc_delay(x: np.ndarray, y: np.ndarray, fs: float, *, max_lag: float, f_lo: float = 1.0,
-              f_hi: float = 30.0, nperseg: int | None = None) -> float:
+              f_hi: float = 30.0, nperseg: int | None = None, min_lag: float = 0.0) -> float:
     """Delay of ``y`` behind ``x`` (s) from a SCOT-weighted generalised cross-correlation.
 
     Parameters
@@ -258,6 +258,8 @@ def gcc_delay(x: np.ndarray, y: np.ndarray, fs: float, *, max_lag: float, f_lo: 
         Band used (the weighting is zero outside).
     nperseg : int, optional
         Welch segment length; default the power of two >= 4 max_lag fs, at most N/2.
+    min_lag : float, s
+        Search ``min_lag <= tau`` only (default 0: from one sample).
 
     Returns
     -------
@@ -278,7 +280,10 @@ def gcc_delay(x: np.ndarray, y: np.ndarray, fs: float, *, max_lag: float, f_lo: 
     with np.errstate(divide="ignore", invalid="ignore"):
         g = np.where(w > 0, pxy / np.sqrt(pxx * pyy), 0.0)
     r = np.fft.irfft(g, L)
-    k = 1 + int(np.argmax(r[1:kmax + 1]))
+    kmin = max(1, int(np.floor(min_lag * fs)))
+    if kmin >= kmax:
+        return float("nan")
+    k = kmin + int(np.argmax(r[kmin:kmax + 1]))
     if 1 <= k < L - 1:
         a, b, c = r[k - 1], r[k], r[k + 1]
         den = a - 2 * b + c

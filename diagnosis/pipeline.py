@@ -29,15 +29,25 @@ defaults) and identifies level ``Gq(n0)`` and waviness ``w`` per segment
    identified on the data with the effect fixed) at the cost of no extra
    simulation; exact for a linear model, first order for the nonlinear effects
    (friction, bump stop, damper asymmetry), which see the level of step 2.
-   The waviness is not refitted per model: an effect that tilts the suspension and
-   axle spectra is partly absorbed by the nominal ``w``.
+   Before the level, the waviness is refitted per model and window as a spectral
+   tilt (:func:`window_tilt`, :func:`apply_tilt`): the nominal ``w`` of step 2
+   absorbs part of any effect that tilts the spectra (a sensor low-pass, tyre
+   enveloping), and without the refit the true effect could not close its gap.
 
 Sensor noise: the measured record carries white sensor noise the simulation lacks.
-Its level per channel is estimated from the measured spectrum between 0.6 and 0.95 of
-the Nyquist frequency (the minimum over 4 s blocks, as ``inverse.features``) and
-seeded white noise of that level is added to every simulation ("the nominal model"
-includes the measured noise floor).  The ``sensor`` candidate calibrates the cutoff
-only, with its own noise switched off.
+Its level per channel is the measured minus the simulated spectrum between 0.6 and
+0.95 of the Nyquist frequency, and seeded white noise of that level is added to every
+simulation ("the nominal model" includes the measured noise floor).  The floor is
+profiled per model and window (:func:`window_noise`): a model that attenuates the top
+of the band leaves more of the measured power there to noise.  The ``sensor``
+candidate calibrates the cutoff only, with its own noise switched off.
+
+speed_scale: realised here (:meth:`TruckModel.run` drives at the recorded speed over
+the factor), identified by the front-to-rear delay term of the ranking
+(:func:`delay_term`, :class:`diagnosis.which.DelayTerm`) and calibrated from it.
+
+Road grid: ``ROAD_DX`` = 0.025 m, the virtual test drive's grid (the footprint filter
+of tyre_enveloping rounds the length to an odd number of grid steps).
 
 Calibration / held-out split (decision): the record is cut into ``n_windows``
 (default 4) equal time windows; windows 1 and 3 (odd, counted from 1) calibrate,
@@ -65,8 +75,8 @@ ROAD_W, ROAD_NMIN, ROAD_NMAX = 2.0, 0.1, 5.0
 GQ_REF = 256e-6
 #: run-in simulated and discarded before every window [s]
 RUNIN_S = 2.0
-#: road grid of the diagnosis simulations [m] (the nominal grid; truth uses finer)
-ROAD_DX, ROAD_DY, ROAD_WIDTH = 0.05, 0.1, 3.0
+#: road grid of the diagnosis simulations [m] (that of the virtual test drive, drives/scenarios)
+ROAD_DX, ROAD_DY, ROAD_WIDTH = 0.025, 0.1, 3.0
 #: measured channel prefixes used
 QUANTITIES = ("susp_disp_", "axle_acc_", "body_acc_")
 #: smoothing ramp between segment pieces of different level [s]
@@ -86,7 +96,7 @@ SEARCH = {
     "leaf_friction": {"force": (200.0, 12000.0)},
     "bump_stop": {"gap": (0.005, 0.08)},
     "damper_asymmetry": {"ratio": (0.3, 6.0)},
-    "payload": {"mass": (-8000.0, 8000.0)},
+    "payload": {"mass": (-14000.0, 14000.0)},
     "speed_scale": {"factor": (0.85, 1.15)},
     "sensor": {"cutoff": (3.0, 60.0)},
 }
@@ -144,6 +154,94 @@ def noise_from_residual(sig: Signals, sim: dict) -> dict:
         _, ps = signal.welch(sim[c] - sim[c].mean(), fs=fs, nperseg=512)
         m = (f >= 0.6 * fs / 2) & (f <= 0.95 * fs / 2)
         out[c] = math.sqrt(max(float(np.mean(pm[m]) - np.mean(ps[m])), 0.0) * fs / 2.0)
+    return out
+
+
+def window_noise(meas: dict, sim: dict, fs: float) -> dict:
+    """White-noise std per channel of one window for one (noise-free) model simulation.
+
+    Measured minus simulated Welch PSD (256-sample periodic Hann segments), mean over
+    0.6-0.95 of the Nyquist frequency, floored at zero, times the Nyquist bandwidth.
+    The noise floor is a nuisance like the road level: it is identified for every model
+    (a model that attenuates the top of the band, e.g. a sensor low-pass or tyre
+    enveloping, leaves more of the measured power there to noise), not once with the
+    nominal model.
+    """
+    from scipy import signal
+
+    names = list(meas)
+    X = np.array([meas[c] - np.mean(meas[c]) for c in names])
+    Y = np.array([sim[c] - np.mean(sim[c]) for c in names])
+    nper = min(256, X.shape[1])
+    f, pm = signal.welch(X, fs=fs, nperseg=nper, axis=-1)
+    _, ps = signal.welch(Y, fs=fs, nperseg=nper, axis=-1)
+    m = (f >= 0.6 * fs / 2) & (f <= 0.95 * fs / 2)
+    d = np.maximum(pm[:, m].mean(axis=1) - ps[:, m].mean(axis=1), 0.0)
+    return {c: math.sqrt(float(v) * fs / 2.0) for c, v in zip(names, d)}
+
+
+#: refit the road waviness per model and window as a spectral tilt (see window_tilt)
+TILT_REFIT = True
+#: bound of the per-model waviness change
+TILT_MAX = 1.0
+#: reference frequency of the tilt [Hz] (the level absorbs the choice)
+TILT_F_REF = 3.0
+
+
+def window_tilt(meas: dict, sim: dict, fs: float, noise: dict) -> float:
+    """Waviness change ``dw`` of the road that best matches ``sim`` to ``meas`` in one window.
+
+    For a linear vehicle at speed ``v`` on a road ``Gq (n/n0)^-w`` the response PSD at
+    ``f`` is ``|H(f)|^2 Gq (f/(v n0))^-w / v``: a change ``dw`` of the waviness multiplies
+    it by ``(f/(v n0))^-dw``, a power law in ``f`` whose speed factor the level absorbs.
+    ``dw`` is the negated slope of the regression of ``ln(P_meas/P_sim)`` (measured noise
+    removed) on ``ln f`` over the third octaves of ``W_FIT_BAND`` and the channels of
+    ``W_FIT_QUANTITIES``, as in :func:`fit_road`, clipped to +-``TILT_MAX``.  This is the
+    waviness part of "the road identified with the effect fixed" at no extra simulation
+    (the nominal waviness of :func:`fit_road` absorbs part of any effect that tilts the
+    spectra, e.g. a sensor low-pass; without the refit the true effect at its true
+    strength could not close its gap).
+    """
+    from scipy import signal
+
+    from diagnosis.bandpower import third_octave_bands
+
+    bands = third_octave_bands(*W_FIT_BAND)
+    xs, ys = [], []
+    names = [c for c in meas if c.startswith(W_FIT_QUANTITIES)]
+    if not names:
+        return 0.0
+    X = np.array([meas[c] - np.mean(meas[c]) for c in names])
+    Y = np.array([sim[c] - np.mean(sim[c]) for c in names])
+    f, PM = signal.welch(X, fs=fs, nperseg=min(256, X.shape[1]), axis=-1)
+    _, PS = signal.welch(Y, fs=fs, nperseg=min(256, X.shape[1]), axis=-1)
+    for c, pm, ps in zip(names, PM, PS):
+        nz = 2.0 * noise.get(c, 0.0) ** 2 / fs
+        for lo, fc, hi in bands:
+            sel = (f >= lo) & (f < hi)
+            if sel.sum() == 0:
+                continue
+            bm = float(np.sum(pm[sel]) - nz * sel.sum())
+            bs = float(np.sum(ps[sel]))
+            if bm > 0 and bs > 0:
+                xs.append(math.log(fc))
+                ys.append(math.log(bm / bs))
+    if len(set(np.round(xs, 6))) < 3:
+        return 0.0
+    return float(np.clip(-np.polyfit(xs, ys, 1)[0], -TILT_MAX, TILT_MAX))
+
+
+def apply_tilt(sim: dict, fs: float, dw: float) -> dict:
+    """Multiply the PSD of every channel by ``(f / TILT_F_REF)^-dw`` (amplitude by the root;
+    frequencies below 0.25 Hz take the 0.25 Hz factor)."""
+    if dw == 0.0:
+        return sim
+    out = {}
+    for c, x in sim.items():
+        X = np.fft.rfft(x - x.mean())
+        f = np.fft.rfftfreq(x.size, 1.0 / fs)
+        X *= (np.maximum(f, 0.25) / TILT_F_REF) ** (-0.5 * dw)
+        out[c] = np.fft.irfft(X, n=x.size) + x.mean()
     return out
 
 
@@ -209,13 +307,16 @@ class TruckModel:
             object.__setattr__(self, "_vp_cache", vp)
         return vp
 
-    def _plan(self, t0: float, t1: float):
-        """Sim-time speed samples, axle-1 start position and the road for window [t0, t1)."""
+    def _plan(self, t0: float, t1: float, speed_factor: float = 1.0):
+        """Sim-time speed samples, axle-1 start position and the road for window [t0, t1).
+
+        ``speed_factor``: recorded speed / true speed (the ``speed_scale`` candidate); the
+        truck is driven at the recorded speed divided by it."""
         fs = self.fs
         n_run = int(round(RUNIN_S * fs))
         i0 = int(round(t0 * fs))
         i1 = min(int(round(t1 * fs)), self.time.size)
-        v_rec = self.speed[i0:i1]
+        v_rec = self.speed[i0:i1] / float(speed_factor)
         v = np.concatenate([np.full(n_run, v_rec[0]), v_rec])
         tau = np.arange(v.size) / fs
         s = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) / fs)])
@@ -226,16 +327,16 @@ class TruckModel:
         t_rec = t0 + tau - RUNIN_S
         return tau, v, s, x_start, x_ref, t_rec, n_run, i1 - i0
 
-    def _road(self, t0, t1, seed, gq):
+    def _road(self, t0, t1, seed, gq, speed_factor=1.0):
         from roadlib.segments import RoadSegment, segmented_surface
 
         wv = np.full(len(gq), ROAD_W) if self.w is None else np.asarray(self.w, float)
         key = (round(t0, 6), round(t1, 6), int(seed), tuple(np.round(np.log(gq), 9)),
                tuple(np.round(wv, 9)), None if self.nmin is None else tuple(self.nmin),
-               None if self.nmax is None else tuple(self.nmax))
+               None if self.nmax is None else tuple(self.nmax), round(float(speed_factor), 9))
         if key in self._roads:
             return self._roads[key]
-        tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1)
+        tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1, speed_factor)
         length = x_start + s[-1] + 3.0
         xb = np.interp(self.bounds[1:-1], t_rec, x_ref)
         edges = np.concatenate([[0.0], np.clip(xb, 0.0, length), [length]])
@@ -260,8 +361,13 @@ class TruckModel:
         from vehicles.simulate import SpeedProfile, simulate
 
         gq = self.gq if gq is None else np.asarray(gq, float)
-        tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1)
-        road = self._road(t0, t1, seed, gq)
+        # speed_scale is realised here, not by the library effect (which only rescales the
+        # output 'speed' channel): the recorded speed is 'factor' x the true speed, so the
+        # truck drives at the recorded speed / factor (road wavelengths, front-to-rear delay)
+        effects = dict(effects or {})
+        sf = float(effects.pop("speed_scale", {}).get("factor", 1.0))
+        tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1, sf)
+        road = self._road(t0, t1, seed, gq, sf)
         prof = SpeedProfile(tau, v)
         dur = (tau.size - 1) / self.fs
         res = simulate(self.vehicle, road, prof, dur, effects=effects or None, x_start=x_start,
@@ -274,9 +380,10 @@ class TruckModel:
             out[c] = x
         return out
 
-    def add_noise(self, chans: dict, seed: int) -> dict:
+    def add_noise(self, chans: dict, seed: int, noise: dict | None = None) -> dict:
+        noise = self.noise if noise is None else noise
         ss = np.random.SeedSequence(int(seed), spawn_key=(0x4E01,)).spawn(len(self.channels))
-        return {c: chans[c] + self.noise.get(c, 0.0) * np.random.default_rng(s).standard_normal(chans[c].size)
+        return {c: chans[c] + noise.get(c, 0.0) * np.random.default_rng(s).standard_normal(chans[c].size)
                 for c, s in zip(self.channels, ss)}
 
     def pieces(self, t0: float, t1: float):
@@ -296,7 +403,8 @@ def _power(x):
     return float(np.var(x)) if x.size > 1 else float("nan")
 
 
-def level_scale(model: TruckModel, meas: dict, sim: dict, t0: float, t1: float) -> np.ndarray:
+def level_scale(model: TruckModel, meas: dict, sim: dict, t0: float, t1: float,
+                noise: dict | None = None) -> np.ndarray:
     """Per-sample amplitude factor that re-levels ``sim`` per segment piece to ``meas``.
 
     Power ratio per channel (measured less its noise power), geometric mean over
@@ -305,11 +413,12 @@ def level_scale(model: TruckModel, meas: dict, sim: dict, t0: float, t1: float) 
     """
     fs = model.fs
     n = next(iter(sim.values())).size
+    noise = model.noise if noise is None else noise
 
     def factor(a, b):
         logs = []
         for c in model.channels:
-            pm = _power(meas[c][a:b]) - model.noise.get(c, 0.0) ** 2
+            pm = _power(meas[c][a:b]) - noise.get(c, 0.0) ** 2
             pm = max(pm, 0.1 * _power(meas[c][a:b]))
             ps = _power(sim[c][a:b])
             if ps > 0 and pm > 0:
@@ -372,9 +481,20 @@ class Simulate:
                 raise
             sim = {c: np.zeros(w.time.size) for c in m.channels}
             sim = {c: x + 1e3 for c, x in sim.items()}
-        g = level_scale(m, w.channels, sim, t0, t1) if any(np.var(x) > 0 for x in sim.values()) else 1.0
-        sim = {c: x * g for c, x in sim.items()}
-        sim = m.add_noise(sim, seed)
+        # nuisances profiled per model and window: the road waviness (a spectral tilt, see
+        # window_tilt), the level with the
+        # nominal noise floor, then the white-noise floor of THIS model (measured minus
+        # simulated PSD at the top of the band), the level again with that floor
+        noise = m.noise
+        if any(np.var(x) > 0 for x in sim.values()):
+            if TILT_REFIT:
+                dw = window_tilt(w.channels, sim, m.fs, m.noise)
+                sim = apply_tilt(sim, m.fs, dw)
+            for _ in range(2):
+                g = level_scale(m, w.channels, sim, t0, t1, noise=noise)
+                noise = window_noise(w.channels, {c: x * g for c, x in sim.items()}, m.fs)
+            sim = {c: x * g for c, x in sim.items()}
+        sim = m.add_noise(sim, seed, noise)
         return Signals(w.time, sim, dict(w.units), w.speed, {"model": "truck", **state.effects})
 
 
@@ -550,7 +670,8 @@ def candidates(names=None):
         fixed = {p.name: p.default for p in eff.parameters if p.name != pname}
         fixed.update(FIXED.get(name, {}))
         out.append(Candidate(name, (Param(pname, float(lo), float(hi),
-                                          log=(lo > 0 and hi / lo >= 10)),), fixed))
+                                          log=(lo > 0 and hi / lo >= 10)),), fixed,
+                             delay_factor=(name == "speed_scale")))
     return out
 
 
@@ -634,8 +755,29 @@ def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fi
                    _time.perf_counter() - t)
 
 
+def delay_term(model: TruckModel):
+    """The front-to-rear delay term of the gap (:class:`diagnosis.which.DelayTerm`): axle
+    accelerations of the front axles (1, 2) against the rear axles (3, 4), both sides, with
+    their distances (pairs whose delay does not fit a window are skipped there)."""
+    from diagnosis.which import DelayTerm
+
+    vp = model._vp()
+    ax = [a.x for a in vp.axles]
+    if len(ax) < 2:
+        return None
+    fronts = [1, 2] if len(ax) >= 4 else [1]
+    rears = [len(ax) - 1, len(ax)] if len(ax) >= 4 else [len(ax)]
+    pairs = [(f"axle_acc_{a}{s}", f"axle_acc_{b}{s}") for a in fronts for b in rears
+             for s in ("L", "R")
+             if f"axle_acc_{a}{s}" in model.channels and f"axle_acc_{b}{s}" in model.channels]
+    if not pairs:
+        return None
+    dist = [abs(ax[int(a[9]) - 1] - ax[int(b[9]) - 1]) for a, b in pairs]
+    return DelayTerm(pairs, dist)
+
+
 def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: int = 4,
-                   n_windows: int = 4) -> dict:
+                   n_windows: int = 4, n_null: int = 8, delay: bool = True) -> dict:
     """Held-out gap of the nominal model and of the model with ``effects`` (given, not
     calibrated), on the seeds ``rank_effects`` uses: the "true shrink" of a blind case
     when ``effects`` is the truth.
@@ -651,9 +793,27 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
                   n_windows=n_windows)
     sc = _Scorer(Fit(ctx.model), Simulate(ctx.model), ctx.calib, ctx.held, seed, 1, n_seeds,
                  None, None)
+    if delay:
+        _set_delay(sc, delay_term(ctx.model), n_null)
     before = float(np.mean([g.value for g in sc.heldout_gaps({})]))
     after = float(np.mean([g.value for g in sc.heldout_gaps(effects)]))
     return {"before": before, "after": after, "shrink_fraction": 1.0 - after / before}
+
+
+def _set_delay(sc, term, n_null: int) -> None:
+    """Give scorer ``sc`` the delay term with the sigma and weight ``rank_effects`` would set."""
+    from diagnosis.gap import band_gap, reference
+
+    if term is None:
+        return
+    state0 = sc.fit({}, sc.heldout)
+    n = max(sc.n_seeds, n_null)
+    nom = [sc.sims(state0, sc.heldout, 1, i) for i in range(n)]
+    sur = [sc.sims(state0, sc.heldout, 2, i) for i in range(n_null)]
+    nb = [band_gap(nom[i], reference(sur[i], sc.ref_held.channels, sc.ref_held.bands)).value
+          for i in range(n_null)]
+    term.weight = 0.5 * float(np.std(nb, ddof=1)) / math.sqrt(2.0)
+    sc.set_delay(term, nom + sur, n)
 
 
 def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quick: bool = False,
@@ -747,9 +907,10 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     if workers and workers > 1:
         with ProcessPoolExecutor(workers) as ex:
             ranking = rank_effects(cands, fit, simulate, calib, held, seed=seed, executor=ex,
-                                   progress=progress, **kw)
+                                   progress=progress, delay=delay_term(model), **kw)
     else:
-        ranking = rank_effects(cands, fit, simulate, calib, held, seed=seed, progress=progress, **kw)
+        ranking = rank_effects(cands, fit, simulate, calib, held, seed=seed, progress=progress,
+                               delay=delay_term(model), **kw)
     timing["ranking_s"] = _time.perf_counter() - t
     timing["total_s"] = _time.perf_counter() - wall0
 

@@ -57,13 +57,20 @@ Procedure
    ``confidence`` is ``"ambiguous"`` when an entry sharing no effect with the
    winner reaches a held-out gap within ``sd0`` of the winner's, else ``"clear"``.
 
+Optional delay term (``delay=DelayTerm(...)``): the front-to-rear delay mismatch, in
+standard errors ``z``, enters every gap as ``c z^2`` with ``c`` = half the null band
+gap's sd over sqrt 2 (see :class:`DelayTerm`); it is what identifies a speed-signal
+scale error, which the road level otherwise absorbs.  A ``Candidate(...,
+delay_factor=True)`` is then calibrated from the delay instead of a search.
+
 What it is not: a global optimiser.  Effects with more than two parameters are
 calibrated over the two chosen in their :class:`Candidate` (others fixed).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass, field, replace
 from itertools import combinations
 from typing import Any, Callable, Mapping, Sequence
 
@@ -73,7 +80,7 @@ from eroad.errors import EroadInputError
 
 from .gap import Gap, band_gap, reference
 
-__all__ = ["Param", "Candidate", "Calibration", "Entry", "NullReference", "Ranking",
+__all__ = ["Param", "Candidate", "Calibration", "Entry", "NullReference", "Ranking", "DelayTerm",
            "candidates_from_library", "calibrate", "rank_effects", "seed_int"]
 
 _GR = (math.sqrt(5) - 1) / 2
@@ -127,6 +134,10 @@ class Candidate:
     name: str
     params: tuple
     fixed: Mapping[str, float] = field(default_factory=dict)
+    #: the single parameter is a speed factor (recorded / true speed): calibrate it from the
+    #: front-to-rear delay (``factor = exp(-rho)`` iterated twice, see DelayTerm) instead of a
+    #: search, when the ranking has a delay term
+    delay_factor: bool = False
 
     def __post_init__(self):
         if not 1 <= len(self.params) <= 2:
@@ -452,33 +463,193 @@ class Ranking:
         return [e.record() for e in self.entries]
 
 
+@dataclass
+class DelayTerm:
+    """Front-to-rear delay mismatch as a term of the gap (road-independent; what identifies
+    a speed-signal scale error, which the road level otherwise absorbs).
+
+    Per window, the delay of each rear channel behind its front channel
+    (:func:`diagnosis.compare.gcc_delay`, SCOT-weighted GCC in ``f_lo``-``f_hi``) is
+    computed on the simulated and the measured window; ``rho_j`` is the mean over the
+    pairs of ``ln(tau_sim / tau_meas)`` (same window, same recorded speed: the speed
+    cancels; the median over the pairs, so that a wrong GCC peak in one pair does not
+    count).  ``z`` is the inverse-variance weighted mean of ``rho_j`` over the windows divided
+    by its standard error, with ``var rho_j = 2 sigma_j^2``: ``sigma_j`` the road-phase
+    standard deviation of window ``j``'s statistic, estimated from nominal simulations of
+    that window over several seeds (:meth:`prepare`, separately for the calibration and the
+    held-out set); the measured side is taken to have the same sampling noise.
+    The gap term is ``weight * z^2``; :func:`rank_effects` sets ``weight`` so that the term's
+    standard deviation under a correct model (``weight sqrt 2``, ``z^2 ~ chi2(1)``) is half
+    the standard deviation of the nominal-vs-nominal band gap.  Only a model that changes
+    the axle-to-axle delay (a speed scale) changes ``z``; with common random numbers the
+    term is the same for every other model.
+    """
+
+    pairs: list
+    distances: list
+    f_lo: float = 1.0
+    f_hi: float = 30.0
+    weight: float = 0.0
+    _meas: dict = field(default_factory=dict, repr=False)
+    _sigma: dict = field(default_factory=dict, repr=False)
+
+    #: delay search per pair and window: LAG_LO x the shortest to LAG_HI x the longest
+    #: kinematic delay ``distance / speed`` of the window (covers speed scales 0.7-1.4)
+    LAG_LO, LAG_HI = 0.7, 1.4
+
+    def log_delays(self, windows) -> np.ndarray:
+        """``ln tau`` per window and pair, (W, P) array (NaN where no delay: no speed, or the
+        delay range does not fit the window's GCC segment)."""
+        from .compare import gcc_delay
+        from .signals import as_signals
+
+        out = np.full((len(windows), len(self.pairs)), np.nan)
+        for j, w in enumerate(windows):
+            s = as_signals(w)
+            if s.speed is None or not np.all(np.asarray(s.speed) > 0.5):
+                continue
+            inv = 1.0 / np.asarray(s.speed, float)
+            n = s.time.size
+            L = int(2 ** np.floor(np.log2(max(16, n // 2))))        # gcc_delay's longest segment
+            for k, ((a, b), d) in enumerate(zip(self.pairs, self.distances)):
+                if a not in s.channels or b not in s.channels:
+                    continue
+                lo, hi = self.LAG_LO * d * inv.min(), self.LAG_HI * d * inv.max()
+                if hi * s.fs > L // 2 - 2:
+                    continue
+                tau = gcc_delay(s.channels[a], s.channels[b], s.fs, max_lag=hi, min_lag=lo,
+                                f_lo=self.f_lo, f_hi=self.f_hi)
+                if np.isfinite(tau) and tau > 0:
+                    out[j, k] = math.log(tau)
+        return out
+
+    def prepare(self, tag: str, windows, sim_sets) -> None:
+        """Measured delays of the window set ``tag`` ("calib" or "held") and its per-window
+        ``sigma`` from nominal simulations of the same windows over several seeds (list of
+        lists): ``sigma_j^2 = mean over seed pairs k < l of rho_j(k, l)^2 / 2``, floored at
+        ``SIGMA_FLOOR``."""
+        self._meas[tag] = self.log_delays(windows)
+        a = [self.log_delays(s) for s in sim_sets]                     # seeds x (W x P)
+        # the statistic itself between every two nominal simulations: rho_j(k, l) has the
+        # variance 2 sigma_j^2 that z assumes (a centre estimated from the same seeds made
+        # sigma about half as large as the null scatter of z showed)
+        r = np.array([self._rho(a[k], a[l]) for k in range(len(a)) for l in range(k + 1, len(a))])
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            n = np.isfinite(r).sum(axis=0)
+            var2 = np.where(n >= 3, np.nansum(r ** 2, axis=0) / np.maximum(n, 1), np.nan)
+            sd = np.sqrt(var2 / 2.0)
+        self._sigma[tag] = np.maximum(np.where(np.isfinite(sd), sd, np.inf), self.SIGMA_FLOOR)
+
+    #: floor of the per-window standard deviation of ``ln tau`` (GCC peak interpolation,
+    #: about a third of a sample at 200 Hz on a 0.5 s delay)
+    SIGMA_FLOOR = 0.003
+
+    @staticmethod
+    def _rho(ls: np.ndarray, lm: np.ndarray) -> np.ndarray:
+        """Per window: median over pairs of ``ln tau_a - ln tau_b`` (a wrong GCC peak in one
+        pair, frequent while the speed changes, does not move it); NaN unless at least half
+        the pairs have a delay on both sides."""
+        d = ls - lm
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return np.array([np.nanmedian(r) if 2 * np.isfinite(r).sum() >= max(1, r.size) else np.nan
+                             for r in d])
+
+    def _parts(self, sims, tag, meas_log=None):
+        rho = self._rho(self.log_delays(sims), self._meas[tag] if meas_log is None else meas_log)
+        sig = np.broadcast_to(np.asarray(self._sigma[tag], float), rho.shape)
+        ok = np.isfinite(rho) & np.isfinite(sig) & (sig > 0)
+        return rho[ok], sig[ok]
+
+    def z(self, sims, tag: str, meas_log=None) -> float:
+        """Inverse-variance weighted mean over windows of ``rho_j`` over its standard error
+        (``2 sigma_j^2`` per window: measured and simulated sides alike)."""
+        rho, sig = self._parts(sims, tag, meas_log)
+        if rho.size == 0:
+            return 0.0
+        wgt = 1.0 / (2.0 * sig ** 2)
+        return float(np.sum(wgt * rho) / math.sqrt(np.sum(wgt)))
+
+    def mean_rho(self, sims, tag: str) -> float:
+        """Inverse-variance weighted mean over windows of ``rho_j`` (``ln tau_sim/tau_meas``)."""
+        rho, sig = self._parts(sims, tag)
+        if rho.size == 0:
+            return 0.0
+        return float(np.sum(rho / sig ** 2) / np.sum(1.0 / sig ** 2))
+
+    def term(self, sims, tag: str, meas_log=None) -> float:
+        if not self.weight or tag not in self._meas:
+            return 0.0
+        return self.weight * self.z(sims, tag, meas_log) ** 2
+
+
 class _Scorer:
     """Evaluations shared by the search, the held-out scoring and the null (picklable)."""
 
-    def __init__(self, fit, simulate, calib, heldout, seed, n_calib_seeds, n_seeds, channels, bands):
+    def __init__(self, fit, simulate, calib, heldout, seed, n_calib_seeds, n_seeds, channels, bands,
+                 delay: DelayTerm | None = None):
         self.fit, self.simulate = fit, simulate
         self.calib, self.heldout = list(calib), list(heldout)
         self.seed = seed
         self.n_calib_seeds, self.n_seeds = n_calib_seeds, n_seeds
         self.ref_calib = reference(self.calib, channels, bands)
         self.ref_held = reference(self.heldout, self.ref_calib.channels, self.ref_calib.bands)
+        self.delay = delay
 
     def sims(self, state, windows, stream, i):
         return [self.simulate(state, w, seed_int(self.seed, (stream, i, j))) for j, w in enumerate(windows)]
 
+    def gap(self, sims, ref, tag, meas_log=None) -> Gap:
+        """Band gap plus the delay term (when set) of window set ``tag`` ("calib", "held")."""
+        g = band_gap(sims, ref)
+        if self.delay is not None and self.delay.weight:
+            g = replace(g, value=g.value + self.delay.term(sims, tag, meas_log))
+        return g
+
     def calib_gap(self, effects) -> float:
         state = self.fit(effects, self.calib)
-        return float(np.mean([band_gap(self.sims(state, self.calib, 0, i), self.ref_calib).value
+        return float(np.mean([self.gap(self.sims(state, self.calib, 0, i), self.ref_calib, "calib").value
                               for i in range(self.n_calib_seeds)]))
 
     def heldout_gaps(self, effects) -> list[Gap]:
         state = self.fit(effects, self.heldout)
-        return [band_gap(self.sims(state, self.heldout, 1, i), self.ref_held)
+        return [self.gap(self.sims(state, self.heldout, 1, i), self.ref_held, "held")
                 for i in range(self.n_seeds)]
 
+    def set_delay(self, delay: "DelayTerm", nominal_held: list, n: int) -> np.ndarray:
+        """Prepare ``delay`` on both window sets (sigma from ``nominal_held``, the nominal
+        held-out simulations and null surrogates, and from ``n`` nominal calibration
+        simulations, stream 3) and attach it; the weight is set by the caller."""
+        delay.prepare("held", self.heldout, nominal_held)
+        state = self.fit({}, self.calib)
+        delay.prepare("calib", self.calib, [self.sims(state, self.calib, 3, i) for i in range(n)])
+        self.delay = delay
+        return delay._sigma["held"]
+
     def score(self, cands, grid, refine, start=None):
-        cal = calibrate(cands, self.calib_gap, grid=grid, refine=refine, start=start)
+        if (len(cands) == 1 and cands[0].delay_factor and start is None and self.delay is not None
+                and self.delay.weight):
+            cal = self.calibrate_from_delay(cands[0])
+        else:
+            cal = calibrate(cands, self.calib_gap, grid=grid, refine=refine, start=start)
         return cal, self.heldout_gaps(cal.effects)
+
+    def calibrate_from_delay(self, cand) -> Calibration:
+        """Speed factor from the calibration windows' delay: the simulated delay scales with
+        the factor exactly (kinematics), so ``factor <- factor exp(-rho)``; two passes."""
+        p = cand.params[0]
+        fac, history = 1.0, []
+        for _ in range(2):
+            eff = {cand.name: dict(cand.fixed, **{p.name: fac})}
+            state = self.fit(eff, self.calib)
+            rho = self.delay.mean_rho(self.sims(state, self.calib, 0, 0), "calib")
+            fac = float(min(p.hi, max(p.lo, fac * math.exp(-rho))))
+            history.append((eff, float("nan")))
+        eff = {cand.name: dict(cand.fixed, **{p.name: fac})}
+        g = self.calib_gap(eff)
+        history.append((eff, g))
+        return Calibration(eff, (_unit(p, fac),), g, len(history), history)
 
 
 
@@ -507,7 +678,8 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                  n_calib_seeds: int = 1, n_null: int | None = None, pairs: bool = True,
                  n_pair_candidates: int = 3, channels: Sequence[str] | None = None,
                  bands: np.ndarray | None = None, z: float = 2.0, grid: int = 5, refine: int = 8,
-                 executor=None, progress: Callable[[str], None] | None = None) -> Ranking:
+                 executor=None, progress: Callable[[str], None] | None = None,
+                 delay: DelayTerm | None = None) -> Ranking:
     """Rank candidate effects by held-out gap, penalised for parameters; never force a verdict.
 
     Parameters
@@ -543,6 +715,9 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     executor : concurrent.futures.Executor, optional
         Candidates are calibrated in parallel with ``executor.map``.
     progress : callable str -> None, optional
+    delay : DelayTerm, optional
+        Front-to-rear delay mismatch added to every gap (see :class:`DelayTerm`); its
+        ``sigma`` and ``weight`` are set here from the nominal simulations.
 
     Returns
     -------
@@ -559,12 +734,32 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     say("nominal model on held-out data")
     state0 = fit({}, sc.heldout)
     nominal_sims = [sc.sims(state0, sc.heldout, 1, i) for i in range(max(n_seeds, n_null))]
-    g0 = [band_gap(nominal_sims[i], sc.ref_held) for i in range(n_seeds)]
+    surrogates = [sc.sims(state0, sc.heldout, 2, i) for i in range(n_null)]
+    null_refs = [reference(s, sc.ref_held.channels, sc.ref_held.bands) for s in surrogates]
+    null_band = np.array([band_gap(nominal_sims[i], null_refs[i]).value for i in range(n_null)])
+    delay_info = None
+    if delay is not None:
+        # the delay term: sigma from the nominal simulations, weight from the band gap's
+        # null spread (the term's null sd = half the band gap's), then part of every gap
+        sd_band = float(np.std(null_band, ddof=1)) if null_band.size > 1 else float("nan")
+        delay.weight = (0.5 * sd_band / math.sqrt(2.0)) if np.isfinite(sd_band) else 0.0
+        sc.set_delay(delay, nominal_sims + surrogates, len(nominal_sims))
+        fin = lambda a: [float(x) if np.isfinite(x) else None for x in a]  # noqa: E731
+        delay_info = {"sigma_log_delay_heldout": fin(delay._sigma["held"]),
+                      "sigma_log_delay_calib": fin(delay._sigma["calib"]),
+                      "weight": delay.weight,
+                      "z_nominal": [delay.z(nominal_sims[i], "held") for i in range(n_seeds)]}
+        say(f"delay term: sigma(ln tau) {np.round(delay._sigma['held'], 4)} per held-out window, "
+            f"weight {delay.weight:.3g}, "
+            f"nominal z {np.mean(delay_info['z_nominal']):+.2f}")
+    g0 = [sc.gap(nominal_sims[i], sc.ref_held, "held") for i in range(n_seeds)]
     before = np.array([g.value for g in g0])
     null = []
     for i in range(n_null):
-        surrogate = reference(sc.sims(state0, sc.heldout, 2, i), sc.ref_held.channels, sc.ref_held.bands)
-        null.append(band_gap(nominal_sims[i], surrogate).value)
+        v = null_band[i]
+        if sc.delay is not None and sc.delay.weight:
+            v += sc.delay.term(nominal_sims[i], "held", sc.delay.log_delays(surrogates[i]))
+        null.append(v)
     null = NullReference(np.array(null))
     sd0 = null.std
     gap_present = bool(before.mean() > null.mean + z * sd0)
@@ -632,7 +827,8 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                   + (f"; {', '.join(e.effect for e in close)} comes close" if close else ""))
     settings = dict(seed=seed, n_seeds=n_seeds, n_calib_seeds=n_calib_seeds, n_null=n_null, z=z,
                     grid=grid, refine=refine, pairs=pairs, channels=sc.ref_held.channels,
-                    n_calib_windows=len(sc.calib), n_heldout_windows=len(sc.heldout))
+                    n_calib_windows=len(sc.calib), n_heldout_windows=len(sc.heldout),
+                    delay=delay_info)
     return Ranking(entries, before, pb_before, floor, _nanmean([g.per_band_floor for g in g0]), null,
                    gap_present, verdict, conf, reason, sc.ref_held.bands, settings)
 
