@@ -125,7 +125,11 @@ def welch_edof(weights: np.ndarray, bins: np.ndarray, L: int, K: int) -> np.ndar
     dj = np.subtract.outer(bins, bins) % L
     sj = np.add.outer(bins, bins) % L
     M = K * (c0[dj] ** 2 + c0[sj] ** 2) + 2 * (K - 1) * (c1[dj] ** 2 + c1[sj] ** 2)
-    s = np.maximum(weights, np.finfo(float).tiny)
+    # the EDOF is scale free: normalise per band so that tiny powers do not underflow in
+    # F (s^2); a band with no power at all gets the EDOF of a flat spectrum
+    top = np.max(weights, axis=-1, keepdims=True)
+    s = np.where(top > 0, np.maximum(weights, 0.0) / np.where(top > 0, top, 1.0), 1.0)
+    s = np.maximum(s, 1e-150)
     E = K * w2 * s.sum(axis=-1)
     F = np.einsum("...i,ij,...j->...", s, M, s)
     return 2 * E ** 2 / F

@@ -47,3 +47,20 @@ def test_band_power_sums_to_variance():
     bs = band_powers(x, 200.0)
     share = (56.23 - 0.447) / 100.0
     assert abs(np.nansum(bs.power) / share - 1) < 0.05
+
+
+def test_edof_is_scale_free_down_to_underflow():
+    """EDOF depends on the shape of the PSD in a band, not its scale: 1 and 1e-200 give the
+    same value (before, s^2 underflowed to 0 and 0/0 gave NaN with a RuntimeWarning); a band
+    with no power gets the flat-spectrum EDOF."""
+    import warnings
+
+    from diagnosis.bandpower import welch_edof
+
+    bins = np.arange(10, 18)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        flat = welch_edof(np.ones(8), bins, 256, 7)
+        assert welch_edof(np.full(8, 1e-200), bins, 256, 7) == pytest.approx(flat, rel=1e-12)
+        assert welch_edof(np.zeros(8), bins, 256, 7) == pytest.approx(flat, rel=1e-12)
+        assert welch_edof(np.r_[1.0, np.zeros(7)], bins, 256, 7) < flat / 3
