@@ -1,5 +1,6 @@
 """Band powers and their equivalent degrees of freedom (diagnosis.bandpower)."""
 import numpy as np
+import pytest
 from scipy import signal
 
 from diagnosis.bandpower import band_powers, third_octave_bands, var_log_power, welch_edof
