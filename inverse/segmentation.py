@@ -465,7 +465,7 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
                 va="bottom", fontsize=9)
     for ax in (a1, a2):
         for j, tb in enumerate(result.t_bounds[1:-1]):
-            ax.axvline(tb, color="C3", lw=1, label="boundary found" if (ax is a2 and j == 0) else None)
+            ax.axvline(tb, color="C3", lw=1, label="boundary found (speed-corrected power)" if (ax is a2 and j == 0) else None)
         if truth_bounds is not None:
             for j, tb in enumerate(np.asarray(truth_bounds)[1:-1]):
                 ax.axvline(tb, color="k", lw=0.8, ls="--", label="true boundary" if (ax is a2 and j == 0) else None)
