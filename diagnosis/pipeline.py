@@ -188,6 +188,22 @@ TILT_MAX = 1.0
 TILT_F_REF = 3.0
 
 
+def _band_log_ratios(f, pm, ps, nz, bands, f_unit, xs, ys) -> None:
+    """Append ln(fc / f_unit) to ``xs`` and ln(measured band power less the white noise
+    ``nz`` per bin / simulated band power) to ``ys`` for every band of ``bands`` (rows lo, fc,
+    hi [Hz]) that holds a bin and where both powers are positive (``pm``, ``ps``: PSDs on
+    the bins ``f``)."""
+    for lo, fc, hi in bands:
+        sel = (f >= lo) & (f < hi)
+        if sel.sum() == 0:
+            continue
+        bm = float(np.sum(pm[sel]) - nz * sel.sum())
+        bs = float(np.sum(ps[sel]))
+        if bm > 0 and bs > 0:
+            xs.append(math.log(fc / f_unit))
+            ys.append(math.log(bm / bs))
+
+
 def window_tilt(meas: dict, sim: dict, fs: float, noise: dict) -> float:
     """Waviness change ``dw`` of the road that best matches ``sim`` to ``meas`` in one window.
 
@@ -216,16 +232,7 @@ def window_tilt(meas: dict, sim: dict, fs: float, noise: dict) -> float:
     f, PM = signal.welch(X, fs=fs, nperseg=min(256, X.shape[1]), axis=-1)
     _, PS = signal.welch(Y, fs=fs, nperseg=min(256, X.shape[1]), axis=-1)
     for c, pm, ps in zip(names, PM, PS):
-        nz = 2.0 * noise.get(c, 0.0) ** 2 / fs
-        for lo, fc, hi in bands:
-            sel = (f >= lo) & (f < hi)
-            if sel.sum() == 0:
-                continue
-            bm = float(np.sum(pm[sel]) - nz * sel.sum())
-            bs = float(np.sum(ps[sel]))
-            if bm > 0 and bs > 0:
-                xs.append(math.log(fc))
-                ys.append(math.log(bm / bs))
+        _band_log_ratios(f, pm, ps, 2.0 * noise.get(c, 0.0) ** 2 / fs, bands, 1.0, xs, ys)
     if len(set(np.round(xs, 6))) < 3:
         return 0.0
     return float(np.clip(-np.polyfit(xs, ys, 1)[0], -TILT_MAX, TILT_MAX))
@@ -610,15 +617,7 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
                     _, p2 = signal.welch(sim[c][i:j] - sim[c][i:j].mean(), fs=fs, nperseg=256)
                     pm, ps = pm + p1 * (j - i), ps + p2 * (j - i)
                 nz = 2.0 * model.noise.get(c, 0.0) ** 2 / fs * sum(j - i for i, j in runs)
-                for lo, fc, hi in bands:
-                    sel = (f >= lo) & (f < hi)
-                    if sel.sum() == 0:
-                        continue
-                    bm = float(np.sum(pm[sel]) - nz * sel.sum())
-                    bs = float(np.sum(ps[sel]))
-                    if bm > 0 and bs > 0:
-                        xs.append(math.log(fc / (v * 0.1)))
-                        ys.append(math.log(bm / bs))
+                _band_log_ratios(f, pm, ps, nz, bands, v * 0.1, xs, ys)
             if len(set(np.round(xs, 6))) >= 3:
                 slope = float(np.polyfit(xs, ys, 1)[0])
                 w[k] = float(np.clip(ROAD_W - slope, *W_RANGE))
