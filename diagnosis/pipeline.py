@@ -565,6 +565,20 @@ def _runs(mask):
     return list(zip(np.nonzero(d == 1)[0], np.nonzero(d == -1)[0]))
 
 
+def _level_logs(model, sig, sim: dict, mk) -> list:
+    """ln(measured power less sensor noise / simulated power) per channel on the samples
+    ``mk`` (the measured power is kept at least 10 % of itself); channels with no power
+    are left out."""
+    logs = []
+    for c in model.channels:
+        x = sig.channels[c][mk]
+        pm = max(_power(x) - model.noise.get(c, 0.0) ** 2, 0.1 * _power(x))
+        ps = _power(sim[c][mk])
+        if ps > 0 and pm > 0:
+            logs.append(math.log(pm / ps))
+    return logs
+
+
 def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
     """Nominal road level and waviness per segment from calibration samples (one simulation).
 
@@ -622,13 +636,7 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
                 slope = float(np.polyfit(xs, ys, 1)[0])
                 w[k] = float(np.clip(ROAD_W - slope, *W_RANGE))
         # level over all channels with the fitted tilt applied to the reference simulation
-        logs = []
-        for c in model.channels:
-            x = sig.channels[c][mk]
-            pm = max(_power(x) - model.noise.get(c, 0.0) ** 2, 0.1 * _power(x))
-            ps = _power(sim[c][mk])
-            if ps > 0 and pm > 0:
-                logs.append(math.log(pm / ps))
+        logs = _level_logs(model, sig, sim, mk)
         gq[k] = GQ_REF * math.exp(float(np.mean(logs))) if logs else GQ_REF
     # the level above was measured with w = 2; re-simulate once with the fitted w and re-level
     model.w = w
@@ -641,13 +649,7 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
         if mk.sum() < fs:
             mk[:] = False
             mk[a:b] = True
-        logs = []
-        for c in model.channels:
-            x = sig.channels[c][mk]
-            pm = max(_power(x) - model.noise.get(c, 0.0) ** 2, 0.1 * _power(x))
-            ps = _power(sim2[c][mk])
-            if ps > 0 and pm > 0:
-                logs.append(math.log(pm / ps))
+        logs = _level_logs(model, sig, sim2, mk)
         if logs:
             gq[k] *= math.exp(float(np.mean(logs)))
     return gq, w
