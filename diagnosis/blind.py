@@ -67,7 +67,7 @@ ACTS = {
     "tyre_enveloping": (("axle_acc", "body_acc", "susp_disp"), 4.0, 56.0),
 }
 #: the ranking budget of the blind run (the whole library, no pairs)
-BLIND_SETTINGS = dict(n_seeds=4, n_null=8, grid=4, refine=3, pairs=False)
+BLIND_SETTINGS = dict(n_seeds=4, n_null=12, grid=4, refine=3, pairs=False)
 
 
 def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None) -> list[dict]:
@@ -175,7 +175,8 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
         oracle = {k: dict(v) for k, v in truth_eff.items()}
         if "sensor" in oracle:        # the nominal model carries the measured noise floor
             oracle["sensor"].update(acc_noise=0.0, disp_noise=0.0)
-        true_shrink = heldout_shrink(blind, oracle, n_seeds=settings["n_seeds"])["shrink_fraction"]
+        true_shrink = heldout_shrink(blind, oracle, n_seeds=settings["n_seeds"],
+                                     n_null=settings["n_null"])["shrink_fraction"]
     t3 = _time.perf_counter()
     res = dict(case, verdict=verdict, confidence=summ.get("verdict_confidence"),
                correct=(verdict == case["effect"]),

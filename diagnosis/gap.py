@@ -37,7 +37,7 @@ from eroad.errors import EroadInputError
 from .bandpower import BandSpectrum, band_powers, third_octave_bands, var_log_power
 from .signals import as_signals
 
-__all__ = ["Gap", "Reference", "reference", "band_gap"]
+__all__ = ["Gap", "Reference", "reference", "band_gap", "sim_spectra"]
 
 
 @dataclass(frozen=True)
@@ -133,7 +133,33 @@ def reference(measured: Sequence, channels: Sequence[str] | None = None,
     return Reference(names, bands, spectra, [w.time.size for w in wins], float(min_nu))
 
 
-def band_gap(simulated: Sequence, ref: Reference) -> Gap:
+def sim_spectra(simulated: Sequence, ref: Reference) -> list:
+    """Band spectra of simulated windows analysed like ``ref``'s measured windows.
+
+    Parameters
+    ----------
+    simulated : sequence of Signals-like, one per measured window (same order)
+    ref : Reference
+
+    Returns
+    -------
+    list of BandSpectrum (reusable against any reference of the same window lengths, e.g.
+    the surrogate measurements of the noise reference)
+    """
+    sims = [as_signals(s) for s in (simulated if isinstance(simulated, (list, tuple)) else [simulated])]
+    if len(sims) != len(ref.spectra):
+        raise EroadInputError(f"gap: {len(sims)} simulated windows for {len(ref.spectra)} measured")
+    out = []
+    for s, bm in zip(sims, ref.spectra):
+        miss = [c for c in ref.channels if c not in s.channels]
+        if miss:
+            raise EroadInputError(f"gap: simulated window lacks channel(s) {', '.join(miss)}")
+        out.append(band_powers(np.vstack([s.channels[c] for c in ref.channels]), s.fs,
+                               ref.bands, nperseg=bm.nperseg))
+    return out
+
+
+def band_gap(simulated: Sequence, ref: Reference, spectra: list | None = None) -> Gap:
     """Gap of simulated windows against a prepared measurement.
 
     Parameters
@@ -141,21 +167,22 @@ def band_gap(simulated: Sequence, ref: Reference) -> Gap:
     simulated : sequence of Signals-like, one per measured window (same order)
         Each analysed with the measured window's Welch segment lengths.
     ref : Reference
+    spectra : list of BandSpectrum, optional
+        :func:`sim_spectra` of ``simulated`` when already computed (``simulated`` is then
+        not read).
 
     Returns
     -------
     Gap
     """
-    sims = [as_signals(s) for s in (simulated if isinstance(simulated, (list, tuple)) else [simulated])]
-    if len(sims) != len(ref.spectra):
-        raise EroadInputError(f"gap: {len(sims)} simulated windows for {len(ref.spectra)} measured")
+    if spectra is None:
+        spectra = sim_spectra(simulated, ref)
+    if len(spectra) != len(ref.spectra):
+        raise EroadInputError(f"gap: {len(spectra)} simulated windows for {len(ref.spectra)} measured")
     d = []
-    for s, bm in zip(sims, ref.spectra):
-        miss = [c for c in ref.channels if c not in s.channels]
-        if miss:
-            raise EroadInputError(f"gap: simulated window lacks channel(s) {', '.join(miss)}")
-        bs: BandSpectrum = band_powers(np.vstack([s.channels[c] for c in ref.channels]), s.fs,
-                                       ref.bands, nperseg=bm.nperseg)
+    for bs, bm in zip(spectra, ref.spectra):
+        if not np.array_equal(np.asarray(bs.nperseg), np.asarray(bm.nperseg)):
+            raise EroadInputError("gap: simulated and measured windows analysed differently")
         ok = bs.nu >= ref.min_nu
         with np.errstate(divide="ignore", invalid="ignore"):
             d.append(np.where(ok, np.log(bs.power / bm.power), np.nan))

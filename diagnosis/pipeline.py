@@ -102,6 +102,9 @@ SEARCH = {
 }
 #: parameters held fixed in the candidates (the sensor's noise is part of the nominal model)
 FIXED = {"sensor": {"acc_noise": 0.0, "disp_noise": 0.0}}
+#: smallest speed factor (recorded / true speed) a simulation may use: every road is made
+#: long enough for it, so all models drive the same surface
+SPEED_FACTOR_MIN = 0.85
 #: effects tried by ``--quick``
 QUICK_EFFECTS = ("frame_flex", "leaf_friction", "payload", "sensor")
 
@@ -334,17 +337,21 @@ class TruckModel:
         t_rec = t0 + tau - RUNIN_S
         return tau, v, s, x_start, x_ref, t_rec, n_run, i1 - i0
 
-    def _road(self, t0, t1, seed, gq, speed_factor=1.0):
+    def _road(self, t0, t1, seed, gq):
+        """The road of window [t0, t1) for road-phase ``seed``: the same surface for every
+        model, speed_scale included (common random numbers: the synthesis depends on the
+        road length, so the length covers the fastest speed factor ``SPEED_FACTOR_MIN`` and
+        the segment edges are placed at the recorded speed)."""
         from roadlib.segments import RoadSegment, segmented_surface
 
         wv = np.full(len(gq), ROAD_W) if self.w is None else np.asarray(self.w, float)
         key = (round(t0, 6), round(t1, 6), int(seed), tuple(np.round(np.log(gq), 9)),
                tuple(np.round(wv, 9)), None if self.nmin is None else tuple(self.nmin),
-               None if self.nmax is None else tuple(self.nmax), round(float(speed_factor), 9))
+               None if self.nmax is None else tuple(self.nmax))
         if key in self._roads:
             return self._roads[key]
-        tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1, speed_factor)
-        length = x_start + s[-1] + 3.0
+        tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1)
+        length = x_start + s[-1] / SPEED_FACTOR_MIN + 3.0
         xb = np.interp(self.bounds[1:-1], t_rec, x_ref)
         edges = np.concatenate([[0.0], np.clip(xb, 0.0, length), [length]])
         segs, k_used = [], []
@@ -374,7 +381,10 @@ class TruckModel:
         effects = dict(effects or {})
         sf = float(effects.pop("speed_scale", {}).get("factor", 1.0))
         tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1, sf)
-        road = self._road(t0, t1, seed, gq, sf)
+        if sf < SPEED_FACTOR_MIN:
+            raise EroadInputError(f"speed_scale factor {sf:g} below {SPEED_FACTOR_MIN:g}: the "
+                                  f"diagnosis road is not long enough")
+        road = self._road(t0, t1, seed, gq)
         prof = SpeedProfile(tau, v)
         dur = (tau.size - 1) / self.fs
         res = simulate(self.vehicle, road, prof, dur, effects=effects or None, x_start=x_start,
@@ -778,7 +788,7 @@ def delay_term(model: TruckModel):
 
 
 def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: int = 4,
-                   n_windows: int = 4, n_null: int = 8, delay: bool = True) -> dict:
+                   n_windows: int = 4, n_null: int = 12, delay: bool = True) -> dict:
     """Held-out gap of the nominal model and of the model with ``effects`` (given, not
     calibrated), on the seeds ``rank_effects`` uses: the "true shrink" of a blind case
     when ``effects`` is the truth.
@@ -835,7 +845,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     workers : int
         Processes for the candidate calibrations.
     quick : bool
-        CI smoke settings: 4 candidates, 3 held-out seeds, 4 null pairs, a 3 + 3
+        CI smoke settings: 4 candidates, 3 held-out seeds, 6 null pairs, a 3 + 3
         search, no pairs.
     force : bool
         Replace an existing report.
@@ -899,8 +909,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     t = _time.perf_counter()
     names = list(effects) if effects else (list(QUICK_EFFECTS) if quick else None)
     cands = candidates(names)
-    kw = dict(n_seeds=3, n_null=4, grid=3, refine=3, pairs=False) if quick else \
-        dict(n_seeds=4, n_null=8, grid=4, refine=4, pairs=True, n_pair_candidates=2)
+    kw = dict(n_seeds=3, n_null=6, grid=3, refine=3, pairs=False) if quick else \
+        dict(n_seeds=4, n_null=12, grid=4, refine=4, pairs=True, n_pair_candidates=2)
     kw.update(settings or {})
     fit, simulate = Fit(model), Simulate(model)
     progress(f"ranking {len(cands)} candidate effect(s) on {len(calib)} calibration + "
