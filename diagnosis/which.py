@@ -47,15 +47,22 @@ Procedure
    nominal model.  Left and right channels and neighbouring bands are correlated,
    so ``n`` overstates the independent information and the penalty is mild; the
    noise gate below is the stronger guard.
-6. A candidate is ACCEPTED when (a) the nominal gap is beyond noise
-   (``mean(before) > mean0 + z sd0``), (b) its held-out improvement
-   ``mean(before - after) > z sd0``, and (c) ``delta_bic < 0``.  Entries are ranked
-   by ``delta_bic``.  Pairs of the ``n_pair_candidates`` best singles are
-   calibrated jointly (start at the single optima, one golden pass per parameter)
-   and accepted only when they also beat the best single by ``z sd0`` and in BIC.
-   The verdict is the best accepted entry (``"a+b"`` for a pair) or ``"none"``.
-   ``confidence`` is ``"ambiguous"`` when an entry sharing no effect with the
-   winner reaches a held-out gap within ``sd0`` of the winner's, else ``"clear"``.
+6. Paired null: every held-out simulation of a model is also scored against each
+   surrogate measurement of step 4; ``mean over seeds of (nominal - model)`` per
+   surrogate is the improvement this model (parameters fixed) reaches when the nominal
+   model is right.  Its standard deviation ``s_c`` is the noise of the improvement along
+   this candidate's own signature (much smaller than ``sd0``, which is mostly road-phase
+   scatter that the paired difference cancels).
+7. A candidate is ACCEPTED when its held-out improvement ``mean(before - after)`` is
+   positive and exceeds its paired null's mean by ``z_paired s_c``, and
+   ``delta_bic < 0``.  Entries are ranked by ``delta_bic``.  Pairs of the
+   ``n_pair_candidates`` best singles are calibrated jointly (start at the single optima,
+   one golden pass per parameter) and accepted only when they also beat the best single
+   by ``z_paired`` sd of the paired null of the difference, and in BIC.  The verdict is
+   the best accepted entry (``"a+b"`` for a pair) or ``"none"``.  ``confidence`` is
+   ``"ambiguous"`` when an entry sharing no effect with the winner reaches a held-out gap
+   within ``sd0`` of the winner's, else ``"clear"``.  ``gap_present`` (nominal gap above
+   ``mean0 + z sd0``) is reported, not required.
 
 Optional delay term (``delay=DelayTerm(...)``): the front-to-rear delay mismatch, in
 standard errors ``z``, enters every gap as ``c z^2`` with ``c`` = half the null band
@@ -772,7 +779,7 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
         Channels scored (default: those of the first calibration window).
     bands : (nb, 3) array, Hz, optional
     z : float
-        Noise gate in standard deviations of the nominal-vs-nominal gap.
+        ``gap_present`` threshold in standard deviations of the nominal-vs-nominal gap.
     grid, refine : int
         Search budget (see :func:`calibrate`).
     executor : concurrent.futures.Executor, optional
@@ -781,6 +788,9 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     delay : DelayTerm, optional
         Front-to-rear delay mismatch added to every gap (see :class:`DelayTerm`); its
         ``sigma`` and ``weight`` are set here from the nominal simulations.
+    z_paired : float
+        Acceptance threshold in standard deviations of each candidate's paired null
+        (see module docstring, steps 6-7).
 
     Returns
     -------
