@@ -791,11 +791,15 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
                    n_windows: int = 4, n_null: int = 12, delay: bool = True) -> dict:
     """Held-out gap of the nominal model and of the model with ``effects`` (given, not
     calibrated), on the seeds ``rank_effects`` uses: the "true shrink" of a blind case
-    when ``effects`` is the truth.
+    when ``effects`` is the truth, and whether that model would pass the ranking's paired
+    gate.
 
     Returns
     -------
-    dict with ``before``, ``after`` (mean gaps) and ``shrink_fraction``.
+    dict with ``before``, ``after`` (mean gaps), ``shrink_fraction``, ``improvement``,
+    ``null_improvement_mean`` and ``null_improvement_sd`` (the paired null of
+    :func:`diagnosis.which.rank_effects` for this model) and ``paired_z`` (improvement less
+    the null mean, in null sd).
     """
     from diagnosis.which import _Scorer
 
@@ -804,27 +808,36 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
                   n_windows=n_windows)
     sc = _Scorer(Fit(ctx.model), Simulate(ctx.model), ctx.calib, ctx.held, seed, 1, n_seeds,
                  None, None)
-    if delay:
-        _set_delay(sc, delay_term(ctx.model), n_null)
-    before = float(np.mean([g.value for g in sc.heldout_gaps({})]))
-    after = float(np.mean([g.value for g in sc.heldout_gaps(effects)]))
-    return {"before": before, "after": after, "shrink_fraction": 1.0 - after / before}
+    surrogates = _set_delay(sc, delay_term(ctx.model) if delay else None, n_null)
+    sc.set_null(surrogates)
+    g0, m0 = sc.heldout_scores({})
+    g1, m1 = sc.heldout_scores(effects)
+    before = float(np.mean([g.value for g in g0]))
+    after = float(np.mean([g.value for g in g1]))
+    null = (m0 - m1).mean(axis=0)
+    mu, sd = float(np.mean(null)), float(np.std(null, ddof=1))
+    imp = before - after
+    return {"before": before, "after": after, "shrink_fraction": 1.0 - after / before,
+            "improvement": imp, "null_improvement_mean": mu, "null_improvement_sd": sd,
+            "paired_z": (imp - mu) / sd if sd > 0 else float("nan")}
 
 
-def _set_delay(sc, term, n_null: int) -> None:
-    """Give scorer ``sc`` the delay term with the sigma and weight ``rank_effects`` would set."""
+def _set_delay(sc, term, n_null: int) -> list:
+    """Give scorer ``sc`` the delay term with the sigma and weight ``rank_effects`` would set
+    (none when ``term`` is None); returns the ``n_null`` surrogate measurements (stream 2)."""
     from diagnosis.gap import band_gap, reference
 
-    if term is None:
-        return
     state0 = sc.fit({}, sc.heldout)
+    sur = [sc.sims(state0, sc.heldout, 2, i) for i in range(n_null)]
+    if term is None:
+        return sur
     n = max(sc.n_seeds, n_null)
     nom = [sc.sims(state0, sc.heldout, 1, i) for i in range(n)]
-    sur = [sc.sims(state0, sc.heldout, 2, i) for i in range(n_null)]
     nb = [band_gap(nom[i], reference(sur[i], sc.ref_held.channels, sc.ref_held.bands)).value
           for i in range(n_null)]
     term.weight = 0.5 * float(np.std(nb, ddof=1)) / math.sqrt(2.0)
     sc.set_delay(term, nom + sur, n)
+    return sur
 
 
 def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quick: bool = False,
