@@ -671,10 +671,12 @@ class _Scorer:
             rows.append(row)
         return gaps, np.array(rows, dtype=float).reshape(len(sim_sets), len(refs))
 
-    def set_null(self, surrogates) -> None:
+    def set_null(self, surrogates, refs=None) -> None:
         """Surrogate measurements (nominal simulations of the held-out windows on other
-        seeds): their references and log delays, for the paired null of every entry."""
-        self.null_refs = [reference(s, self.ref_held.channels, self.ref_held.bands) for s in surrogates]
+        seeds): their references (``refs`` when already made) and log delays, for the
+        paired null of every entry."""
+        self.null_refs = list(refs) if refs is not None else \
+            [reference(s, self.ref_held.channels, self.ref_held.bands) for s in surrogates]
         self.null_logs = ([self.delay.log_delays(s) for s in surrogates]
                           if self.delay is not None and self.delay.weight else None)
 
@@ -825,7 +827,7 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
         say(f"delay term: sigma(ln tau) {np.round(delay._sigma['held'], 4)} per held-out window, "
             f"weight {delay.weight:.3g}, "
             f"nominal z {np.mean(delay_info['z_nominal']):+.2f}")
-    sc.set_null(surrogates)
+    sc.set_null(surrogates, null_refs)
     g0, null0 = sc.score_sims(nominal_sims[:n_seeds])
     before = np.array([g.value for g in g0])
     null = []
