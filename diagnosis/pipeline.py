@@ -870,7 +870,10 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         The cheap road fit (default) or the full inverse fit of the whole record
         (``inverse.pipeline.invert`` on the Exudyn truck; segments, Gq, w, nmin, nmax).
     settings : dict, optional
-        Overrides of the ``rank_effects`` budget (``n_seeds``, ``n_null``, ``grid``,
+        Overrides of the ``rank_effects`` budget; ``folds=2`` runs the ranking twice with the
+        calibration and held-out windows swapped and combines the two
+        (:func:`diagnosis.which.combine_folds`; about twice the time, no pairs).  Budget keys:
+        (``n_seeds``, ``n_null``, ``grid``,
         ``refine``, ``pairs``, ...).
 
     Returns
@@ -882,7 +885,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
 
     from diagnosis.compare import distribution_shape, front_rear, transmissibility
     from diagnosis.report import write_report
-    from diagnosis.which import rank_effects
+    from diagnosis.which import combine_folds, rank_effects
     from diagnosis.where import localize
     from vehicles.params import load_vehicle
 
@@ -925,16 +928,25 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     kw = dict(n_seeds=3, n_null=6, grid=3, refine=3, pairs=False) if quick else \
         dict(n_seeds=4, n_null=12, grid=4, refine=4, pairs=True, n_pair_candidates=2)
     kw.update(settings or {})
+    folds = int(kw.pop("folds", 1))
+    if folds not in (1, 2):
+        raise EroadInputError(f"folds must be 1 or 2, got {folds}")
+    if folds == 2:
+        kw["pairs"] = False            # pairs are calibrated per fold; not combined
     fit, simulate = Fit(model), Simulate(model)
     progress(f"ranking {len(cands)} candidate effect(s) on {len(calib)} calibration + "
-             f"{len(held)} held-out windows ({workers} worker(s))")
-    if workers and workers > 1:
-        with ProcessPoolExecutor(workers) as ex:
-            ranking = rank_effects(cands, fit, simulate, calib, held, seed=seed, executor=ex,
-                                   progress=progress, delay=delay_term(model), **kw)
-    else:
-        ranking = rank_effects(cands, fit, simulate, calib, held, seed=seed, progress=progress,
-                               delay=delay_term(model), **kw)
+             f"{len(held)} held-out windows ({workers} worker(s)"
+             + (", two folds: then the roles swapped)" if folds == 2 else ")"))
+    splits = [(calib, held, seed)] + ([(held, calib, seed + 1)] if folds == 2 else [])
+    ex = ProcessPoolExecutor(workers) if workers and workers > 1 else None
+    try:
+        rankings = [rank_effects(cands, fit, simulate, c, h, seed=sd, executor=ex,
+                                 progress=progress, delay=delay_term(model), **kw)
+                    for c, h, sd in splits]
+    finally:
+        if ex is not None:
+            ex.shutdown()
+    ranking = rankings[0] if folds == 1 else combine_folds(rankings)
     timing["ranking_s"] = _time.perf_counter() - t
     timing["total_s"] = _time.perf_counter() - wall0
 
@@ -950,13 +962,14 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                      "windows" if road_fit == "levels" else
                      "inverse.pipeline.invert on the whole record (nominal truck)")
         + "; level re-profiled per segment piece for every model and window",
-        "split": f"{n_windows} equal time windows; odd windows calibrate, even windows held out",
+        "split": f"{n_windows} equal time windows; odd windows calibrate, even windows held out"
+        + ("; then the other way round (two folds, combined)" if folds == 2 else ""),
         "calibration_windows_s": [list(map(float, e)) for e in cal_edges],
         "heldout_windows_s": [[float(edges[i]), float(edges[i + 1])] for i in range(n_windows)
                               if i % 2 == 1],
         "noise_std": model.noise, "wheelbase_m": wheelbase, "quick": bool(quick), "seed": int(seed),
         "workers": int(workers), "candidates": [c.name for c in cands],
-        "ranking_settings": {k: v for k, v in kw.items()},
+        "ranking_settings": {**{k: v for k, v in kw.items()}, "folds": folds},
         "timing": {k: round(v, 2) for k, v in timing.items()},
     }
     write_report(out, localization=loc, transmissibility=tr, front_rear=fr, shape=sh,

@@ -88,7 +88,7 @@ from eroad.errors import EroadInputError
 from .gap import Gap, band_gap, reference, sim_spectra
 
 __all__ = ["Param", "Candidate", "Calibration", "Entry", "NullReference", "Ranking", "DelayTerm",
-           "candidates_from_library", "calibrate", "rank_effects", "seed_int"]
+           "candidates_from_library", "calibrate", "rank_effects", "combine_folds", "seed_int"]
 
 _GR = (math.sqrt(5) - 1) / 2
 
@@ -383,6 +383,7 @@ class Entry:
     floor: float = float("nan")
     null_gaps: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     null_improvement: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    fold_effects: list = field(default_factory=list)
 
     @property
     def null_sd(self) -> float:
@@ -440,6 +441,7 @@ class Entry:
             "null_improvement_mean": (float(np.mean(self.null_improvement))
                                       if self.null_improvement.size else None),
             "null_improvement_sd": self.null_sd if self.null_improvement.size > 1 else None,
+            **({"parameters_per_fold": self.fold_effects} if self.fold_effects else {}),
             "per_band_before": [None if not np.isfinite(v) else float(v) for v in self.per_band_before],
             "per_band_after": [None if not np.isfinite(v) else float(v) for v in self.per_band_after],
         }
@@ -894,11 +896,24 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                 e = replace(e, accepted=False)
             entries.append(e)
 
-    entries.sort(key=lambda e: (not e.accepted, e.delta_bic))
-    win = entries[0] if entries[0].accepted else None
+    entries, verdict, conf, reason = _decide(entries, before, null, gap_present, z_paired)
+    settings = dict(seed=seed, n_seeds=n_seeds, n_calib_seeds=n_calib_seeds, n_null=n_null, z=z,
+                    z_paired=z_paired,
+                    grid=grid, refine=refine, pairs=pairs, channels=sc.ref_held.channels,
+                    n_calib_windows=len(sc.calib), n_heldout_windows=len(sc.heldout),
+                    delay=delay_info)
+    return Ranking(entries, before, pb_before, floor, _nanmean([g.per_band_floor for g in g0]), null,
+                   gap_present, verdict, conf, reason, sc.ref_held.bands, settings)
+
+
+def _decide(entries, before, null: NullReference, gap_present: bool, z_paired: float):
+    """Sort the entries (accepted first, then by BIC) and give verdict, confidence, reason."""
+    sd0 = null.std
+    entries = sorted(entries, key=lambda e: (not e.accepted, e.delta_bic))
+    win = entries[0] if entries and entries[0].accepted else None
     if win is None and not gap_present:
         verdict, conf = "none", "none"
-        reason = (f"the nominal held-out gap {before.mean():.3g} is within noise "
+        reason = (f"the nominal held-out gap {np.mean(before):.3g} is within noise "
                   f"(nominal-vs-nominal {null.mean:.3g} +- {sd0:.2g}) and no candidate explains "
                   f"part of it beyond noise")
     elif win is None:
@@ -920,13 +935,53 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                   f"{win.heldout_gap_after:.3g} (improvement {win.improvement:.3g}, paired noise "
                   f"sd {win.null_sd:.2g})"
                   + (f"; {', '.join(e.effect for e in close)} comes close" if close else ""))
-    settings = dict(seed=seed, n_seeds=n_seeds, n_calib_seeds=n_calib_seeds, n_null=n_null, z=z,
-                    z_paired=z_paired,
-                    grid=grid, refine=refine, pairs=pairs, channels=sc.ref_held.channels,
-                    n_calib_windows=len(sc.calib), n_heldout_windows=len(sc.heldout),
-                    delay=delay_info)
-    return Ranking(entries, before, pb_before, floor, _nanmean([g.per_band_floor for g in g0]), null,
-                   gap_present, verdict, conf, reason, sc.ref_held.bands, settings)
+    return entries, verdict, conf, reason
+
+
+def combine_folds(rankings: Sequence[Ranking], z_paired: float | None = None) -> Ranking:
+    """Two-fold (or k-fold) cross-fitting: rankings of the same candidates with the roles of
+    calibration and held-out windows swapped, combined into one.
+
+    Per model the held-out gaps, the paired null improvements (per surrogate) and the
+    per-band gaps are averaged over the folds (the folds' held-out windows are disjoint and
+    their surrogates independent, so the null spread of the mean shrinks like the noise of
+    the improvement); BIC sums the folds' log-likelihood terms over all held-out cells.
+    Acceptance and verdict as in :func:`rank_effects`.  Only singles present in every fold
+    are combined (pairs are calibrated per fold and dropped).  ``effects`` is the first
+    fold's calibration; ``fold_effects`` keeps every fold's.
+    """
+    rs = list(rankings)
+    if not rs:
+        raise EroadInputError("combine_folds: no ranking")
+    z_paired = float(rs[0].settings.get("z_paired", 3.0) if z_paired is None else z_paired)
+    z = float(rs[0].settings.get("z", 2.0))
+    before = np.mean([r.before for r in rs], axis=0)
+    null = NullReference(np.mean([r.null.gaps for r in rs], axis=0))
+    gap_present = bool(before.mean() > null.mean + z * null.std)
+    n_total = sum(r.entries[0].n_cells for r in rs if r.entries)
+    floor = float(np.mean([r.floor for r in rs]))
+    pb_before = _nanmean([r.per_band_before for r in rs])
+    names = [e.effect for e in rs[0].entries if "+" not in e.effect
+             and all(any(f.effect == e.effect for f in r.entries) for r in rs)]
+    entries = []
+    for name in names:
+        es = [next(f for f in r.entries if f.effect == name) for r in rs]
+        ll = sum(e.n_cells * math.log(e.heldout_gap_after / e.heldout_gap_before) for e in es)
+        imp0 = np.mean([e.null_improvement for e in es], axis=0)
+        e = Entry(name, es[0].effects, es[0].k, float(np.mean([e.calib_gap for e in es])), before,
+                  np.mean([e.after for e in es], axis=0), pb_before,
+                  _nanmean([e.per_band_after for e in es]), n_total,
+                  sum(e.n_evals for e in es), float(ll + es[0].k * math.log(n_total)),
+                  floor=floor, null_gaps=np.mean([e.null_gaps for e in es], axis=0),
+                  null_improvement=imp0, fold_effects=[e.effects for e in es])
+        bn = bool(e.improvement > 0 and imp0.size > 1
+                  and e.improvement - float(np.mean(imp0)) > z_paired * e.null_sd)
+        entries.append(replace(e, beyond_noise=bn, accepted=bool(bn and e.delta_bic < 0)))
+    entries, verdict, conf, reason = _decide(entries, before, null, gap_present, z_paired)
+    settings = dict(rs[0].settings, folds=len(rs),
+                    fold_settings=[r.settings for r in rs])
+    return Ranking(entries, before, pb_before, floor, _nanmean([r.per_band_floor for r in rs]), null,
+                   gap_present, verdict, conf, reason, rs[0].bands, settings)
 
 
 def _unit(p: Param, x: float) -> float:
