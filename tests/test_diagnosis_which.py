@@ -124,3 +124,28 @@ def test_paired_null_names_an_effect_the_whole_gap_noise_hides():
     assert w.null_improvement.size == 8
     rec = w.record()
     assert rec["null_improvement_sd"] == pytest.approx(w.null_sd)
+
+
+def test_two_folds_combine_the_held_out_evidence():
+    """Cross-fitting: rank with windows (1, 3) calibrating and (2, 4) held out, then the other
+    way round, and combine.  The combined improvement and paired null are the means of the
+    folds' (so the null spread of independent folds shrinks), BIC adds the folds' terms; the
+    true tyre stiffness x1.5 is named and null data stay "none"."""
+    from diagnosis.which import combine_folds
+
+    for truth, want in (({"tyre_stiffness": {"scale": 1.5}}, "tyre_stiffness"), ({}, "none")):
+        calib, held = _windows(truth, 11)
+        rs = [rank_effects(toy.TOY_CANDIDATES, toy.fit, toy.simulate, c, h, seed=sd, n_seeds=4,
+                           n_null=8, grid=4, refine=5, pairs=False)
+              for c, h, sd in ((calib, held, 5), (held, calib, 6))]
+        r = combine_folds(rs)
+        assert r.verdict == want
+        assert r.settings["folds"] == 2
+        for e in r.entries:
+            es = [next(f for f in x.entries if f.effect == e.effect) for x in rs]
+            assert e.improvement == pytest.approx(np.mean([f.improvement for f in es]))
+            assert e.null_improvement == pytest.approx(np.mean([f.null_improvement for f in es], axis=0))
+            assert len(e.fold_effects) == 2
+        if want != "none":
+            w = r.winner
+            assert w.null_sd < max(f.null_sd for x in rs for f in x.entries if f.effect == want)
