@@ -29,6 +29,9 @@ def register(subparsers) -> None:
                    help="road identification: 'levels' (default: segment level and waviness "
                    "from the nominal model on the calibration windows, seconds) or 'inverse' "
                    "(the full inverse fit of the whole record, Gq, w, nmin, nmax; about a minute)")
+    p.add_argument("--folds", type=int, choices=(1, 2), default=1,
+                   help="2: rank a second time with calibration and held-out windows swapped and "
+                   "combine (twice the held-out evidence, about twice the time, no pairs)")
     p.add_argument("--quick", action="store_true",
                    help="smoke-test settings: 4 candidates, fewer seeds, shorter search, no pairs")
     p.add_argument("--json", action="store_true", help="print summary.json's verdict part as JSON")
@@ -48,7 +51,9 @@ def run(args) -> int:
     progress = (lambda msg: print(msg, file=sys.stderr, flush=True)) if args.json else None
     kw = {"progress": progress} if progress else {}
     summary = diagnose(args.dataset, args.out, vehicle=args.vehicle, effects=effects,
-                       workers=args.workers, quick=args.quick, force=args.force, seed=args.seed, road_fit=args.road_fit, **kw)
+                       workers=args.workers, quick=args.quick, force=args.force, seed=args.seed,
+                       road_fit=args.road_fit, settings={"folds": args.folds} if args.folds != 1 else None,
+                       **kw)
     if args.json:
         best = summary["ranking"][0] if summary.get("ranking") else None
         print(json.dumps({"verdict": summary["verdict"],
