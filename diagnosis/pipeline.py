@@ -146,24 +146,15 @@ def noise_std(sig: Signals, names, block_s: float = 4.0) -> dict:
 
 
 def noise_from_residual(sig: Signals, sim: dict) -> dict:
-    """White-noise std per channel: measured minus simulated (noise-free) PSD between 0.6 and
-    0.95 of the Nyquist frequency, floored at zero, times the Nyquist bandwidth."""
-    from scipy import signal
-
-    fs = sig.fs
-    out = {}
-    for c, x in sig.channels.items():
-        f, pm = signal.welch(x - x.mean(), fs=fs, nperseg=512)
-        _, ps = signal.welch(sim[c] - sim[c].mean(), fs=fs, nperseg=512)
-        m = (f >= 0.6 * fs / 2) & (f <= 0.95 * fs / 2)
-        out[c] = math.sqrt(max(float(np.mean(pm[m]) - np.mean(ps[m])), 0.0) * fs / 2.0)
-    return out
+    """White-noise std per channel of the whole record: :func:`window_noise` with
+    512-sample Welch segments."""
+    return window_noise(sig.channels, sim, sig.fs, nperseg=512)
 
 
-def window_noise(meas: dict, sim: dict, fs: float) -> dict:
+def window_noise(meas: dict, sim: dict, fs: float, nperseg: int = 256) -> dict:
     """White-noise std per channel of one window for one (noise-free) model simulation.
 
-    Measured minus simulated Welch PSD (256-sample periodic Hann segments), mean over
+    Measured minus simulated Welch PSD (``nperseg``-sample Hann segments), mean over
     0.6-0.95 of the Nyquist frequency, floored at zero, times the Nyquist bandwidth.
     The noise floor is a nuisance like the road level: it is identified for every model
     (a model that attenuates the top of the band, e.g. a sensor low-pass or tyre
@@ -175,7 +166,7 @@ def window_noise(meas: dict, sim: dict, fs: float) -> dict:
     names = list(meas)
     X = np.array([meas[c] - np.mean(meas[c]) for c in names])
     Y = np.array([sim[c] - np.mean(sim[c]) for c in names])
-    nper = min(256, X.shape[1])
+    nper = min(int(nperseg), X.shape[1])
     f, pm = signal.welch(X, fs=fs, nperseg=nper, axis=-1)
     _, ps = signal.welch(Y, fs=fs, nperseg=nper, axis=-1)
     m = (f >= 0.6 * fs / 2) & (f <= 0.95 * fs / 2)
