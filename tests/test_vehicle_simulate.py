@@ -210,3 +210,40 @@ def test_cli_simulate_and_effects(tmp_path, capsys):
         assert e["description"] and e["parameters"]
         for p in e["parameters"]:
             assert p["unit"] and p["range"][0] <= p["default"] <= p["range"][1]
+
+
+def test_simulations_release_their_exudyn_systems(road_c):
+    """Each simulation frees its Exudyn system.  The PreStep road feed (and the symbolic
+    suspension terms of nonlinear effects) are Python objects held by the C++ system that
+    refer back to it: a cycle the garbage collector cannot see.  Before the fix every
+    simulation leaked ~4.5 MB and a 30-case blind run was killed by the OOM killer.
+    Checked two ways: no road-feed closure survives a collection, and every model that
+    ``simulate`` builds is released (its system reset) when it returns or fails."""
+    import gc
+
+    import vehicles.simulate as vsim
+
+    def feeds():
+        gc.collect()
+        return sum(1 for o in gc.get_objects()
+                   if type(o).__name__ == "function" and o.__name__ == "prestep")
+
+    before = feeds()
+    built = []
+    real = vsim.build_model
+
+    def spy(*a, **k):
+        m = real(*a, **k)
+        built.append(m)
+        return m
+
+    with mock.patch.object(vsim, "build_model", spy):
+        for _ in range(2):
+            simulate("dump_truck_8x4", road_c, 10.0, 1.0,
+                     effects={"leaf_friction": {"force": 1500.0}})
+        with pytest.raises(EroadInputError):       # refused after the model is built
+            simulate("dump_truck_8x4", random_road(length=60.0, width=1.0, seed=1), 10.0, 1.0)
+    assert feeds() == before
+    assert len(built) >= 3
+    for m in built:
+        assert m.SC.NumberOfSystems() == 0, "an Exudyn system was not released"

@@ -253,6 +253,15 @@ class VehicleModel:
     injector: int = -1
     _keep: list = field(default_factory=list)   # symbolic user functions must stay alive
 
+    def release(self) -> None:
+        """Free the Exudyn system.  A Python user function stored in the C++ system that
+        refers back to it (the PreStep road feed, the symbolic suspension terms) makes a
+        reference cycle the garbage collector cannot see: without this every simulation
+        leaked its whole system (about 4 MB for the 8x4 truck).  The model is unusable
+        afterwards."""
+        self.SC.Reset()
+        self._keep.clear()
+
     # ------------------------------------------------------------------ geometry
     @property
     def bodies(self) -> list:

@@ -363,9 +363,19 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     return res
 
 
-def _simulate(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_start, y_offset,
-              seed, frame_segments, newton) -> SimResult:
-    """One attempt of :func:`simulate` (``newton`` None: only for nonlinear effects)."""
+def _simulate(*args, **kw) -> SimResult:
+    """One attempt of :func:`simulate` (``newton`` None: only for nonlinear effects); the
+    Exudyn systems it builds are released afterwards, whatever happens."""
+    built: list = []
+    try:
+        return _simulate_once(*args, built=built, **kw)
+    finally:
+        for m in built:
+            m.release()
+
+
+def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_start,
+                   y_offset, seed, frame_segments, newton, built) -> SimResult:
     wall0 = _time.perf_counter()
     cpu0 = _time.process_time()
     import exudyn as exu
@@ -433,6 +443,7 @@ def _simulate(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_st
             return out
     model = build_model(vp, chassis=ctx.chassis, frame_segments=ctx.frame_segments,
                         stiffness_factor=ctx.stiffness_factor, suspension_terms=terms_of)
+    built.append(model)
     if road.y.size > 1:
         ys = y_offset + np.array([c.y for c in model.contacts])
         if ys.min() < road.y[0] - 1e-9 or ys.max() > road.y[-1] + 1e-9:
@@ -444,6 +455,7 @@ def _simulate(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_st
         ref_model = build_model(ctx.reference_vp, chassis=ctx.chassis,
                                 frame_segments=ctx.frame_segments,
                                 stiffness_factor=ctx.stiffness_factor)
+        built.append(ref_model)
 
     # ---- road input on the step grid
     zr, zr_t = road_under_tyres(road_used, model, x_start, y_offset, s_steps,
