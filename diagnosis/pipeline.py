@@ -83,6 +83,12 @@ QUANTITIES = ("susp_disp_", "axle_acc_", "body_acc_")
 RAMP_S = 0.5
 #: pieces shorter than this take the level of the whole window [s]
 MIN_PIECE_S = 1.5
+#: nonlinear candidates (bump stop, leaf friction, damper asymmetry) are simulated on the
+#: road the nominal model's level fit gives the window (the same seed's nominal run
+#: re-levelled per segment piece, its factors squared into Gq), then re-levelled as every
+#: model is: an amplitude-dependent effect must see the road amplitude the truck saw, not
+#: the calibration fit's (a bump stop simulated at a level 30 % low never engages)
+PRE_LEVEL = True
 
 #: candidate search ranges (name -> {param: (lo, hi)}, primary parameter only) narrower
 #: than the library's validity ranges: the physically sensible span of a model error
@@ -421,6 +427,26 @@ def level_scale(model: TruckModel, meas: dict, sim: dict, t0: float, t1: float,
     """
     fs = model.fs
     n = next(iter(sim.values())).size
+    whole, vals = piece_levels(model, meas, sim, t0, t1, noise)
+    g = np.full(n, whole)
+    for a, b, f in vals:
+        g[a:b] = f
+    # smooth steps between pieces
+    r = int(RAMP_S * fs / 2)
+    for (a0, b0, f0), (a1, b1, f1) in zip(vals[:-1], vals[1:]):
+        lo, hi = max(0, b0 - r), min(n, a1 + r)
+        if hi - lo > 1:
+            g[lo:hi] = np.linspace(f0, f1, hi - lo)
+    return g
+
+
+def piece_levels(model: TruckModel, meas: dict, sim: dict, t0: float, t1: float,
+                 noise: dict | None = None):
+    """Amplitude factors of :func:`level_scale`: the whole window's and, per segment piece,
+    ``(a, b, factor)`` in window samples (pieces shorter than ``MIN_PIECE_S`` take the
+    window's).  The piece's segment is ``model.pieces(t0, t1)[i][0]``."""
+    fs = model.fs
+    n = next(iter(sim.values())).size
     noise = model.noise if noise is None else noise
 
     def factor(a, b):
@@ -434,20 +460,9 @@ def level_scale(model: TruckModel, meas: dict, sim: dict, t0: float, t1: float,
         return math.exp(0.5 * float(np.mean(logs))) if logs else 1.0
 
     whole = factor(0, n)
-    g = np.full(n, whole)
-    pcs = model.pieces(t0, t1)
-    vals = []
-    for k, a, b in pcs:
-        f = factor(a, b) if (b - a) / fs >= MIN_PIECE_S else whole
-        g[a:b] = f
-        vals.append((a, b, f))
-    # smooth steps between pieces
-    r = int(RAMP_S * fs / 2)
-    for (a0, b0, f0), (a1, b1, f1) in zip(vals[:-1], vals[1:]):
-        lo, hi = max(0, b0 - r), min(n, a1 + r)
-        if hi - lo > 1:
-            g[lo:hi] = np.linspace(f0, f1, hi - lo)
-    return g
+    vals = [(a, b, factor(a, b) if (b - a) / fs >= MIN_PIECE_S else whole)
+            for k, a, b in model.pieces(t0, t1)]
+    return whole, vals
 
 
 # --------------------------------------------------------------------------- the callables
@@ -475,14 +490,42 @@ class Simulate:
 
     def __init__(self, model: TruckModel):
         self.model = model
+        self._pre = {}
+
+    def __getstate__(self):
+        return {"model": self.model, "_pre": {}}
+
+    def prelevel_gq(self, w: Signals, t0: float, t1: float, seed: int) -> np.ndarray:
+        """Per-segment Gq of window [t0, t1) and road seed ``seed`` at which the nominal
+        model matches the measured level piece by piece (``PRE_LEVEL``); cached."""
+        m = self.model
+        key = (round(t0, 6), round(t1, 6), int(seed))
+        gq = self._pre.get(key)
+        if gq is None:
+            nom = m.run({}, t0, t1, seed)
+            if TILT_REFIT:
+                nom = apply_tilt(nom, m.fs, window_tilt(w.channels, nom, m.fs, m.noise))
+            _, vals = piece_levels(m, w.channels, nom, t0, t1, m.noise)
+            gq = np.array(m.gq, float)
+            for (k, _a, _b), (_a2, _b2, f) in zip(m.pieces(t0, t1), vals):
+                gq[k] *= f * f
+            if len(self._pre) > 256:
+                self._pre.clear()
+            self._pre[key] = gq
+        return gq
 
     def __call__(self, state, window, seed):
+        from vehicles.effects import EFFECTS
+
         w = as_signals(window)
         m = self.model
         t0 = float(w.meta["t0"])
         t1 = t0 + w.time.size / m.fs
+        gq = None
+        if PRE_LEVEL and any(EFFECTS[n].nonlinear for n in state.effects if n in EFFECTS):
+            gq = self.prelevel_gq(w, t0, t1, seed)
         try:
-            sim = m.run(state.effects, t0, t1, seed)
+            sim = m.run(state.effects, t0, t1, seed, gq=gq)
         except Exception as exc:  # a diverging candidate scores as a very bad model
             from eroad.errors import SimulationError
             if not isinstance(exc, SimulationError):
