@@ -89,6 +89,10 @@ MIN_PIECE_S = 1.5
 #: model is: an amplitude-dependent effect must see the road amplitude the truck saw, not
 #: the calibration fit's (a bump stop simulated at a level 30 % low never engages)
 PRE_LEVEL = True
+#: the skewness of the suspension displacements is a term of every gap (``shape_term``,
+#: :class:`diagnosis.which.ShapeTerm`): what separates a bump stop from a payload error
+#: with the same spectra (blind case 13: measured skewness -0.4 to -1.1, nominal 0, se 0.13)
+SHAPE_TERM = True
 
 #: candidate search ranges (name -> {param: (lo, hi)}, primary parameter only) narrower
 #: than the library's validity ranges: the physically sensible span of a model error
@@ -821,6 +825,15 @@ def delay_term(model: TruckModel):
     return DelayTerm(pairs, dist)
 
 
+def shape_term(model: TruckModel):
+    """The amplitude-distribution term of the gap (:class:`diagnosis.which.ShapeTerm`): the
+    skewness of every suspension displacement channel."""
+    from diagnosis.which import ShapeTerm
+
+    ch = [c for c in model.channels if c.startswith("susp_disp_")]
+    return ShapeTerm(ch) if ch and SHAPE_TERM else None
+
+
 def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: int = 4,
                    n_windows: int = 4, n_null: int = 12, delay: bool = True) -> dict:
     """Held-out gap of the nominal model and of the model with ``effects`` (given, not
@@ -842,7 +855,8 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
                   n_windows=n_windows)
     sc = _Scorer(Fit(ctx.model), Simulate(ctx.model), ctx.calib, ctx.held, seed, 1, n_seeds,
                  None, None)
-    surrogates = _set_delay(sc, delay_term(ctx.model) if delay else None, n_null)
+    terms = [delay_term(ctx.model), shape_term(ctx.model)] if delay else []
+    surrogates = _set_terms(sc, terms, n_null)
     sc.set_null(surrogates)
     g0, m0 = sc.heldout_scores({})
     g1, m1 = sc.heldout_scores(effects)
@@ -856,21 +870,24 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
             "paired_z": (imp - mu) / sd if sd > 0 else float("nan")}
 
 
-def _set_delay(sc, term, n_null: int) -> list:
-    """Give scorer ``sc`` the delay term with the sigma and weight ``rank_effects`` would set
-    (none when ``term`` is None); returns the ``n_null`` surrogate measurements (stream 2)."""
+def _set_terms(sc, terms, n_null: int) -> list:
+    """Give scorer ``sc`` the gap terms (delay, shape; None entries skipped) with the sigma
+    and weight ``rank_effects`` would set; returns the ``n_null`` surrogate measurements
+    (stream 2)."""
     from diagnosis.gap import band_gap, reference
 
     state0 = sc.fit({}, sc.heldout)
     sur = [sc.sims(state0, sc.heldout, 2, i) for i in range(n_null)]
-    if term is None:
+    terms = [t for t in terms if t is not None]
+    if not terms:
         return sur
     n = max(sc.n_seeds, n_null)
     nom = [sc.sims(state0, sc.heldout, 1, i) for i in range(n)]
     nb = [band_gap(nom[i], reference(sur[i], sc.ref_held.channels, sc.ref_held.bands)).value
           for i in range(n_null)]
-    term.weight = 0.5 * float(np.std(nb, ddof=1)) / math.sqrt(2.0)
-    sc.set_delay(term, nom + sur, n)
+    for t in terms:
+        t.weight = 0.5 * float(np.std(nb, ddof=1)) / math.sqrt(2.0)
+    sc.add_terms(terms, nom + sur, n)
     return sur
 
 
@@ -975,7 +992,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     ex = ProcessPoolExecutor(workers) if workers and workers > 1 else None
     try:
         rankings = [rank_effects(cands, fit, simulate, c, h, seed=sd, executor=ex,
-                                 progress=progress, delay=delay_term(model), **kw)
+                                 progress=progress, delay=delay_term(model),
+                                 shape=shape_term(model), **kw)
                     for c, h, sd in splits]
     finally:
         if ex is not None:

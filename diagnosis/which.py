@@ -488,8 +488,88 @@ class Ranking:
         return [e.record() for e in self.entries]
 
 
+class WindowTerm:
+    """A road-independent per-window statistic compared between simulation and measurement,
+    as a term of the gap (base of :class:`DelayTerm` and :class:`ShapeTerm`).
+
+    Subclasses give ``stats(windows) -> (W, P) array`` (one value per window and channel or
+    channel pair, NaN where none) and ``_rho(sim, meas) -> (W,)`` (the per-window mismatch,
+    aggregated over the P columns).  ``z`` is the inverse-variance weighted mean of
+    ``rho_j`` over the windows divided by its standard error, with ``var rho_j = 2 sigma_j^2``:
+    ``sigma_j`` the road-phase standard deviation of window ``j``'s statistic, estimated from
+    nominal simulations of that window over several seeds (:meth:`prepare`, separately for
+    the calibration and the held-out set); the measured side is taken to have the same
+    sampling noise.  The gap term is ``weight * z^2``; :func:`rank_effects` sets ``weight``
+    so that the term's standard deviation under a correct model (``weight sqrt 2``,
+    ``z^2 ~ chi2(1)``) is half the standard deviation of the nominal-vs-nominal band gap.
+    With common random numbers the term is the same for every model that does not change
+    the statistic.  Needs attributes ``weight``, ``_meas`` and ``_sigma`` (dicts).
+    """
+
+    #: floor of the per-window standard deviation of the statistic
+    SIGMA_FLOOR = 0.0
+    #: name used in progress lines and the ranking settings
+    label = "term"
+
+    def stats(self, windows) -> np.ndarray:   # pragma: no cover - abstract
+        raise NotImplementedError
+
+    @staticmethod
+    def _rho(ls: np.ndarray, lm: np.ndarray) -> np.ndarray:   # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def prepare(self, tag: str, windows, sim_sets) -> None:
+        """Measured statistics of the window set ``tag`` ("calib" or "held") and its
+        per-window ``sigma`` from nominal simulations of the same windows over several seeds
+        (list of lists): ``sigma_j^2 = mean over seed pairs k < l of rho_j(k, l)^2 / 2``,
+        floored at ``SIGMA_FLOOR``."""
+        self._meas[tag] = self.stats(windows)
+        a = [self.stats(s) for s in sim_sets]                          # seeds x (W x P)
+        # the statistic itself between every two nominal simulations: rho_j(k, l) has the
+        # variance 2 sigma_j^2 that z assumes (a centre estimated from the same seeds made
+        # sigma about half as large as the null scatter of z showed)
+        r = np.array([self._rho(a[k], a[l]) for k in range(len(a)) for l in range(k + 1, len(a))])
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            n = np.isfinite(r).sum(axis=0)
+            var2 = np.where(n >= 3, np.nansum(r ** 2, axis=0) / np.maximum(n, 1), np.nan)
+            sd = np.sqrt(var2 / 2.0)
+        self._sigma[tag] = np.maximum(np.where(np.isfinite(sd), sd, np.inf), self.SIGMA_FLOOR)
+
+    def _parts(self, sims, tag, meas_log=None, sim_log=None):
+        sl = self.stats(sims) if sim_log is None else sim_log
+        rho = self._rho(sl, self._meas[tag] if meas_log is None else meas_log)
+        sig = np.broadcast_to(np.asarray(self._sigma[tag], float), rho.shape)
+        ok = np.isfinite(rho) & np.isfinite(sig) & (sig > 0)
+        return rho[ok], sig[ok]
+
+    def z(self, sims, tag: str, meas_log=None, sim_log=None) -> float:
+        """Inverse-variance weighted mean over windows of ``rho_j`` over its standard error
+        (``2 sigma_j^2`` per window: measured and simulated sides alike)."""
+        rho, sig = self._parts(sims, tag, meas_log, sim_log)
+        if rho.size == 0:
+            return 0.0
+        wgt = 1.0 / (2.0 * sig ** 2)
+        return float(np.sum(wgt * rho) / math.sqrt(np.sum(wgt)))
+
+    def mean_rho(self, sims, tag: str) -> float:
+        """Inverse-variance weighted mean over windows of ``rho_j``."""
+        rho, sig = self._parts(sims, tag)
+        if rho.size == 0:
+            return 0.0
+        return float(np.sum(rho / sig ** 2) / np.sum(1.0 / sig ** 2))
+
+    def term(self, sims, tag: str, meas_log=None, sim_log=None) -> float:
+        """``weight z^2`` (0 before :meth:`prepare` or with no weight); ``meas_log``: the
+        statistics of another "measurement" (a surrogate), ``sim_log``: those of ``sims``
+        when already computed."""
+        if not self.weight or tag not in self._meas:
+            return 0.0
+        return self.weight * self.z(sims, tag, meas_log, sim_log) ** 2
+
+
 @dataclass
-class DelayTerm:
+class DelayTerm(WindowTerm):
     """Front-to-rear delay mismatch as a term of the gap (road-independent; what identifies
     a speed-signal scale error, which the road level otherwise absorbs).
 
@@ -548,27 +628,13 @@ class DelayTerm:
                     out[j, k] = math.log(tau)
         return out
 
-    def prepare(self, tag: str, windows, sim_sets) -> None:
-        """Measured delays of the window set ``tag`` ("calib" or "held") and its per-window
-        ``sigma`` from nominal simulations of the same windows over several seeds (list of
-        lists): ``sigma_j^2 = mean over seed pairs k < l of rho_j(k, l)^2 / 2``, floored at
-        ``SIGMA_FLOOR``."""
-        self._meas[tag] = self.log_delays(windows)
-        a = [self.log_delays(s) for s in sim_sets]                     # seeds x (W x P)
-        # the statistic itself between every two nominal simulations: rho_j(k, l) has the
-        # variance 2 sigma_j^2 that z assumes (a centre estimated from the same seeds made
-        # sigma about half as large as the null scatter of z showed)
-        r = np.array([self._rho(a[k], a[l]) for k in range(len(a)) for l in range(k + 1, len(a))])
-        with np.errstate(all="ignore"), warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            n = np.isfinite(r).sum(axis=0)
-            var2 = np.where(n >= 3, np.nansum(r ** 2, axis=0) / np.maximum(n, 1), np.nan)
-            sd = np.sqrt(var2 / 2.0)
-        self._sigma[tag] = np.maximum(np.where(np.isfinite(sd), sd, np.inf), self.SIGMA_FLOOR)
-
     #: floor of the per-window standard deviation of ``ln tau`` (GCC peak interpolation,
     #: about a third of a sample at 200 Hz on a 0.5 s delay)
     SIGMA_FLOOR = 0.003
+    label = "delay"
+
+    def stats(self, windows) -> np.ndarray:
+        return self.log_delays(windows)
 
     @staticmethod
     def _rho(ls: np.ndarray, lm: np.ndarray) -> np.ndarray:
@@ -581,60 +647,78 @@ class DelayTerm:
             return np.array([np.nanmedian(r) if 2 * np.isfinite(r).sum() >= max(1, r.size) else np.nan
                              for r in d])
 
-    def _parts(self, sims, tag, meas_log=None, sim_log=None):
-        sl = self.log_delays(sims) if sim_log is None else sim_log
-        rho = self._rho(sl, self._meas[tag] if meas_log is None else meas_log)
-        sig = np.broadcast_to(np.asarray(self._sigma[tag], float), rho.shape)
-        ok = np.isfinite(rho) & np.isfinite(sig) & (sig > 0)
-        return rho[ok], sig[ok]
 
-    def z(self, sims, tag: str, meas_log=None, sim_log=None) -> float:
-        """Inverse-variance weighted mean over windows of ``rho_j`` over its standard error
-        (``2 sigma_j^2`` per window: measured and simulated sides alike)."""
-        rho, sig = self._parts(sims, tag, meas_log, sim_log)
-        if rho.size == 0:
-            return 0.0
-        wgt = 1.0 / (2.0 * sig ** 2)
-        return float(np.sum(wgt * rho) / math.sqrt(np.sum(wgt)))
+@dataclass
+class ShapeTerm(WindowTerm):
+    """Amplitude-distribution mismatch as a term of the gap: the skewness of the suspension
+    displacements (road-independent in expectation: a Gaussian road through a linear model
+    gives symmetric responses, so only a nonlinear effect, a bump stop or an asymmetric
+    damper, skews them; band powers cannot see it, and a linear rival such as a payload
+    error can mimic such an effect's spectra).  Per window, ``rho_j`` is the mean over
+    ``channels`` of ``g1_sim - g1_meas`` (the sample skewness; the channels of one vehicle
+    skew the same way).  The rest as :class:`WindowTerm`.
+    """
 
-    def mean_rho(self, sims, tag: str) -> float:
-        """Inverse-variance weighted mean over windows of ``rho_j`` (``ln tau_sim/tau_meas``)."""
-        rho, sig = self._parts(sims, tag)
-        if rho.size == 0:
-            return 0.0
-        return float(np.sum(rho / sig ** 2) / np.sum(1.0 / sig ** 2))
+    channels: list
+    weight: float = 0.0
+    _meas: dict = field(default_factory=dict, repr=False)
+    _sigma: dict = field(default_factory=dict, repr=False)
 
-    def term(self, sims, tag: str, meas_log=None, sim_log=None) -> float:
-        """``weight z^2`` (0 before :meth:`prepare` or with no weight); ``meas_log``: the
-        log delays of another "measurement" (a surrogate), ``sim_log``: those of ``sims``
-        when already computed."""
-        if not self.weight or tag not in self._meas:
-            return 0.0
-        return self.weight * self.z(sims, tag, meas_log, sim_log) ** 2
+    #: skewness of a 7.5 s window scatters by about 0.1-0.3 between road phases; a floor
+    #: keeps a window whose nominal seeds happen to agree from dominating
+    SIGMA_FLOOR = 0.02
+    label = "shape"
+
+    def stats(self, windows) -> np.ndarray:
+        """Sample skewness per window and channel, (W, C) array."""
+        from .signals import as_signals
+
+        out = np.full((len(windows), len(self.channels)), np.nan)
+        for j, w in enumerate(windows):
+            ch = as_signals(w).channels
+            for k, c in enumerate(self.channels):
+                if c in ch:
+                    x = np.asarray(ch[c], float)
+                    x = x - x.mean()
+                    m2 = float(np.mean(x * x))
+                    if m2 > 0:
+                        out[j, k] = float(np.mean(x ** 3)) / m2 ** 1.5
+        return out
+
+    @staticmethod
+    def _rho(ls: np.ndarray, lm: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return np.nanmean(ls - lm, axis=1)
 
 
 class _Scorer:
     """Evaluations shared by the search, the held-out scoring and the null (picklable)."""
 
-    def __init__(self, fit, simulate, calib, heldout, seed, n_calib_seeds, n_seeds, channels, bands,
-                 delay: DelayTerm | None = None):
+    def __init__(self, fit, simulate, calib, heldout, seed, n_calib_seeds, n_seeds, channels, bands):
         self.fit, self.simulate = fit, simulate
         self.calib, self.heldout = list(calib), list(heldout)
         self.seed = seed
         self.n_calib_seeds, self.n_seeds = n_calib_seeds, n_seeds
         self.ref_calib = reference(self.calib, channels, bands)
         self.ref_held = reference(self.heldout, self.ref_calib.channels, self.ref_calib.bands)
-        self.delay = delay
+        self.terms: list[WindowTerm] = []      # weighted terms added to every gap
+        self.null_stats = None
+
+    @property
+    def delay(self) -> DelayTerm | None:
+        return next((t for t in self.terms if isinstance(t, DelayTerm)), None)
 
     def sims(self, state, windows, stream, i):
         return [self.simulate(state, w, seed_int(self.seed, (stream, i, j))) for j, w in enumerate(windows)]
 
     def gap(self, sims, ref, tag, meas_log=None) -> Gap:
-        """Band gap plus the delay term (when set) of window set ``tag`` ("calib", "held")."""
+        """Band gap plus the terms (when set) of window set ``tag`` ("calib", "held");
+        ``meas_log``: the terms' statistics of another measurement (one per term)."""
         g = band_gap(sims, ref)
-        if self.delay is not None and self.delay.weight:
-            g = replace(g, value=g.value + self.delay.term(sims, tag, meas_log))
-        return g
+        extra = sum(t.term(sims, tag, None if meas_log is None else meas_log[i])
+                    for i, t in enumerate(self.terms))
+        return replace(g, value=g.value + extra) if extra else g
 
     def calib_gap(self, effects) -> float:
         state = self.fit(effects, self.calib)
@@ -657,40 +741,41 @@ class _Scorer:
         refs = getattr(self, "null_refs", None) or []
         for sims in sim_sets:
             spec = sim_spectra(sims, self.ref_held)
-            slog = None
-            if self.delay is not None and self.delay.weight:
-                slog = self.delay.log_delays(sims)
+            slog = [t.stats(sims) for t in self.terms]      # computed once per simulation
             g = band_gap(sims, self.ref_held, spec)
-            if slog is not None:
-                g = replace(g, value=g.value + self.delay.term(sims, "held", sim_log=slog))
-            gaps.append(g)
+            extra = sum(t.term(sims, "held", sim_log=sl) for t, sl in zip(self.terms, slog))
+            gaps.append(replace(g, value=g.value + extra) if extra else g)
             row = []
             for k, ref in enumerate(refs):
                 v = band_gap(sims, ref, spec).value
-                if slog is not None:
-                    v += self.delay.term(sims, "held", self.null_logs[k], slog)
+                v += sum(t.term(sims, "held", self.null_stats[k][i], sl)
+                         for i, (t, sl) in enumerate(zip(self.terms, slog)))
                 row.append(v)
             rows.append(row)
         return gaps, np.array(rows, dtype=float).reshape(len(sim_sets), len(refs))
 
     def set_null(self, surrogates, refs=None) -> None:
         """Surrogate measurements (nominal simulations of the held-out windows on other
-        seeds): their references (``refs`` when already made) and log delays, for the
-        paired null of every entry."""
+        seeds): their references (``refs`` when already made) and the terms' statistics,
+        for the paired null of every entry."""
         self.null_refs = list(refs) if refs is not None else \
             [reference(s, self.ref_held.channels, self.ref_held.bands) for s in surrogates]
-        self.null_logs = ([self.delay.log_delays(s) for s in surrogates]
-                          if self.delay is not None and self.delay.weight else None)
+        self.null_stats = [[t.stats(s) for t in self.terms] for s in surrogates]
 
-    def set_delay(self, delay: "DelayTerm", nominal_held: list, n: int) -> np.ndarray:
-        """Prepare ``delay`` on both window sets (sigma from ``nominal_held``, the nominal
+    def add_terms(self, terms, nominal_held: list, n: int) -> None:
+        """Prepare ``terms`` on both window sets (sigma from ``nominal_held``, the nominal
         held-out simulations and null surrogates, and from ``n`` nominal calibration
-        simulations, stream 3) and attach it; the weight is set by the caller."""
-        delay.prepare("held", self.heldout, nominal_held)
+        simulations, stream 3) and attach them; the weights are set by the caller.  Call
+        before :meth:`set_null`."""
+        terms = [t for t in terms if t is not None]
+        if not terms:
+            return
         state = self.fit({}, self.calib)
-        delay.prepare("calib", self.calib, [self.sims(state, self.calib, 3, i) for i in range(n)])
-        self.delay = delay
-        return delay._sigma["held"]
+        cal = [self.sims(state, self.calib, 3, i) for i in range(n)]
+        for t in terms:
+            t.prepare("held", self.heldout, nominal_held)
+            t.prepare("calib", self.calib, cal)
+            self.terms.append(t)
 
     def score(self, cands, grid, refine, start=None):
         if (len(cands) == 1 and cands[0].delay_factor and start is None and self.delay is not None
@@ -753,7 +838,8 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                  n_pair_candidates: int = 3, channels: Sequence[str] | None = None,
                  bands: np.ndarray | None = None, z: float = 2.0, grid: int = 5, refine: int = 8,
                  executor=None, progress: Callable[[str], None] | None = None,
-                 delay: DelayTerm | None = None, z_paired: float = 3.0) -> Ranking:
+                 delay: DelayTerm | None = None, shape: "ShapeTerm | None" = None,
+                 z_paired: float = 3.0) -> Ranking:
     """Rank candidate effects by held-out gap, penalised for parameters; never force a verdict.
 
     Parameters
@@ -792,6 +878,9 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     delay : DelayTerm, optional
         Front-to-rear delay mismatch added to every gap (see :class:`DelayTerm`); its
         ``sigma`` and ``weight`` are set here from the nominal simulations.
+    shape : ShapeTerm, optional
+        Amplitude-distribution (skewness) mismatch added to every gap, weighted as the
+        delay term (see :class:`ShapeTerm`).
     z_paired : float
         Acceptance threshold in standard deviations of each candidate's paired null
         (see module docstring, steps 6-7).
@@ -814,30 +903,27 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     surrogates = [sc.sims(state0, sc.heldout, 2, i) for i in range(n_null)]
     null_refs = [reference(s, sc.ref_held.channels, sc.ref_held.bands) for s in surrogates]
     null_band = np.array([band_gap(nominal_sims[i], null_refs[i]).value for i in range(n_null)])
-    delay_info = None
-    if delay is not None:
-        # the delay term: sigma from the nominal simulations, weight from the band gap's
-        # null spread (the term's null sd = half the band gap's), then part of every gap
+    term_info = {}
+    terms = [t for t in (delay, shape) if t is not None]
+    if terms:
+        # the terms: sigma from the nominal simulations, weight from the band gap's null
+        # spread (each term's null sd = half the band gap's), then part of every gap
         sd_band = float(np.std(null_band, ddof=1)) if null_band.size > 1 else float("nan")
-        delay.weight = (0.5 * sd_band / math.sqrt(2.0)) if np.isfinite(sd_band) else 0.0
-        sc.set_delay(delay, nominal_sims + surrogates, len(nominal_sims))
+        for t in terms:
+            t.weight = (0.5 * sd_band / math.sqrt(2.0)) if np.isfinite(sd_band) else 0.0
+        sc.add_terms(terms, nominal_sims + surrogates, len(nominal_sims))
         fin = lambda a: [float(x) if np.isfinite(x) else None for x in a]  # noqa: E731
-        delay_info = {"sigma_log_delay_heldout": fin(delay._sigma["held"]),
-                      "sigma_log_delay_calib": fin(delay._sigma["calib"]),
-                      "weight": delay.weight,
-                      "z_nominal": [delay.z(nominal_sims[i], "held") for i in range(n_seeds)]}
-        say(f"delay term: sigma(ln tau) {np.round(delay._sigma['held'], 4)} per held-out window, "
-            f"weight {delay.weight:.3g}, "
-            f"nominal z {np.mean(delay_info['z_nominal']):+.2f}")
+        for t in terms:
+            term_info[t.label] = {"sigma_heldout": fin(t._sigma["held"]),
+                                  "sigma_calib": fin(t._sigma["calib"]), "weight": t.weight,
+                                  "z_nominal": [t.z(nominal_sims[i], "held") for i in range(n_seeds)]}
+            say(f"{t.label} term: sigma {np.round(t._sigma['held'], 4)} per held-out window, "
+                f"weight {t.weight:.3g}, nominal z {np.mean(term_info[t.label]['z_nominal']):+.2f}")
     sc.set_null(surrogates, null_refs)
     g0, null0 = sc.score_sims(nominal_sims[:n_seeds])
     before = np.array([g.value for g in g0])
-    null = []
-    for i in range(n_null):
-        v = null_band[i]
-        if sc.delay is not None and sc.delay.weight:
-            v += sc.delay.term(nominal_sims[i], "held", sc.null_logs[i])
-        null.append(v)
+    null = [null_band[i] + sum(t.term(nominal_sims[i], "held", sc.null_stats[i][k])
+                               for k, t in enumerate(sc.terms)) for i in range(n_null)]
     null = NullReference(np.array(null))
     sd0 = null.std
     gap_present = bool(before.mean() > null.mean + z * sd0)
@@ -901,7 +987,7 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                     z_paired=z_paired,
                     grid=grid, refine=refine, pairs=pairs, channels=sc.ref_held.channels,
                     n_calib_windows=len(sc.calib), n_heldout_windows=len(sc.heldout),
-                    delay=delay_info)
+                    delay=term_info.get("delay"), shape=term_info.get("shape"))
     return Ranking(entries, before, pb_before, floor, _nanmean([g.per_band_floor for g in g0]), null,
                    gap_present, verdict, conf, reason, sc.ref_held.bands, settings)
 
