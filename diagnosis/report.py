@@ -386,7 +386,8 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
         L.append("## Which effect\n")
         L.append(f"Each candidate calibrated on calibration windows, scored on held-out windows "
                  f"(gap = inverse-variance weighted mean of ln(P_sim/P_meas)^2 over channels, bands, "
-                 f"windows; mean over {len(nom['heldout_gap_per_seed'])} road-phase seeds). Nominal "
+                 f"windows{_terms_text(nom.get('settings') or {})}; mean over "
+                 f"{len(nom['heldout_gap_per_seed'])} road-phase seeds). Nominal "
                  f"held-out gap {nom['heldout_gap']:.3g}; a correct model would give "
                  f"{nom['null_gap_mean']:.3g} +- {_fmt(nom['null_gap_std'], '{:.2g}')} "
                  f"(nominal vs nominal). Accepted: the held-out improvement (nominal gap minus "
@@ -424,6 +425,22 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
              "ISO 18571) are not used: the simulated road is a random-phase realisation, not the "
              "measured one. See docs/diagnosis.md.\n")
     return "\n".join(L)
+
+
+def _terms_text(settings: Mapping) -> str:
+    """The road-independent terms of the gap, with the nominal model's z on held-out data."""
+    what = {"delay": "the front-to-rear delay mismatch",
+            "shape": "the suspension-displacement skewness mismatch"}
+    parts = []
+    for key, text in what.items():
+        t = settings.get(key)
+        if t and t.get("weight"):
+            z = t.get("z_nominal") or []
+            parts.append(f"{text} (nominal z {sum(z) / len(z):+.1f})" if z else text)
+    if not parts:
+        return ""
+    return (", plus " + " and ".join(parts) + ", each as w z^2 with z in standard errors of "
+            "the road-phase scatter and w set so that its null spread is half the band gap's")
 
 
 def write_report(out: str | os.PathLike, *, localization=None, transmissibility=None,
