@@ -20,6 +20,7 @@ resumed (cases already in blind.json are kept).
 Usage::
 
     nice python benchmarks/bench_diagnosis.py --n 30 --out results/diagnosis-blind [--workers 2]
+    nice python benchmarks/bench_diagnosis.py --n 10 --seed 1 --null-only --out results/nulls
 
 Timings are printed, never asserted.
 """
@@ -52,6 +53,10 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0, help="root seed of the cases")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--duration", type=float, default=None, help="record length [s] (default 30)")
+    ap.add_argument("--folds", type=int, choices=(1, 2), default=None,
+                    help="ranking folds (default: that of diagnosis.blind.BLIND_SETTINGS)")
+    ap.add_argument("--null-only", action="store_true",
+                    help="every case a null drive (the extra null validation: --seed 1)")
     args = ap.parse_args(argv)
 
     from diagnosis.blind import format_confusion, run_blind
@@ -60,6 +65,8 @@ def main(argv=None) -> int:
     print(f"reference: one nominal 30 s truck simulation {ref:.2f} s", flush=True)
     t = time.perf_counter()
     out = run_blind(args.out, args.n, seed=args.seed, workers=args.workers, duration=args.duration,
+                    settings=None if args.folds is None else {"folds": args.folds},
+                    n_null=args.n if args.null_only else None,
                     progress=lambda m: print(m, flush=True))
     wall = time.perf_counter() - t
     sc = out["score"]

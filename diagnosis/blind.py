@@ -69,7 +69,7 @@ ACTS = {
 #: the acceptance threshold of the ranking (rank_effects' z_paired), for "detectable"
 Z_PAIRED = 3.0
 #: the ranking budget of the blind run (the whole library, no pairs)
-BLIND_SETTINGS = dict(n_seeds=4, n_null=12, grid=4, refine=3, pairs=False)
+BLIND_SETTINGS = dict(n_seeds=4, n_null=12, grid=4, refine=3, pairs=False, folds=2)
 
 
 def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None) -> list[dict]:
@@ -249,7 +249,7 @@ def format_confusion(sc: dict) -> str:
 
 
 def run_blind(root, n: int = 30, *, seed: int = 0, workers: int = 2, duration=None, settings=None,
-              progress=print) -> dict:
+              n_null: int | None = None, progress=print) -> dict:
     """Run ``n`` blind cases under ``root``; write ``root/blind.json`` and ``root/confusion.txt``.
 
     Cases already scored in ``root/blind.json`` are reused (the run can be resumed).
@@ -263,7 +263,7 @@ def run_blind(root, n: int = 30, *, seed: int = 0, workers: int = 2, duration=No
     results = []
     t0 = _time.perf_counter()
     # case ids are stable; a redrawn road changes a case's dataset seed (recorded in results)
-    for case in make_cases(n, seed):
+    for case in make_cases(n, seed, n_null=n_null):
         r = done.get(case["case"])
         if r is None or r.get("value") != case["value"]:
             r = run_case(case, root, workers=workers, settings=settings, duration=duration,

@@ -29,9 +29,10 @@ def register(subparsers) -> None:
                    help="road identification: 'levels' (default: segment level and waviness "
                    "from the nominal model on the calibration windows, seconds) or 'inverse' "
                    "(the full inverse fit of the whole record, Gq, w, nmin, nmax; about a minute)")
-    p.add_argument("--folds", type=int, choices=(1, 2), default=1,
-                   help="2: rank a second time with calibration and held-out windows swapped and "
-                   "combine (twice the held-out evidence, about twice the time, no pairs)")
+    p.add_argument("--folds", type=int, choices=(1, 2), default=None,
+                   help="2 (default; 1 with --quick): rank a second time with calibration and "
+                   "held-out windows swapped and combine (twice the held-out evidence, twice the "
+                   "time, no pairs); 1: one ranking, plus pairs of the two best effects")
     p.add_argument("--quick", action="store_true",
                    help="smoke-test settings: 4 candidates, fewer seeds, shorter search, no pairs")
     p.add_argument("--json", action="store_true", help="print summary.json's verdict part as JSON")
@@ -52,7 +53,7 @@ def run(args) -> int:
     kw = {"progress": progress} if progress else {}
     summary = diagnose(args.dataset, args.out, vehicle=args.vehicle, effects=effects,
                        workers=args.workers, quick=args.quick, force=args.force, seed=args.seed,
-                       road_fit=args.road_fit, settings={"folds": args.folds} if args.folds != 1 else None,
+                       road_fit=args.road_fit, settings=None if args.folds is None else {"folds": args.folds},
                        **kw)
     if args.json:
         best = summary["ranking"][0] if summary.get("ranking") else None

@@ -921,11 +921,11 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         The cheap road fit (default) or the full inverse fit of the whole record
         (``inverse.pipeline.invert`` on the Exudyn truck; segments, Gq, w, nmin, nmax).
     settings : dict, optional
-        Overrides of the ``rank_effects`` budget; ``folds=2`` runs the ranking twice with the
-        calibration and held-out windows swapped and combines the two
-        (:func:`diagnosis.which.combine_folds`; about twice the time, no pairs).  Budget keys:
-        (``n_seeds``, ``n_null``, ``grid``,
-        ``refine``, ``pairs``, ...).
+        Overrides of the ``rank_effects`` budget.  ``folds``: 2 (default; 1 with ``quick``)
+        runs the ranking twice with the calibration and held-out windows swapped and
+        combines the two (:func:`diagnosis.which.combine_folds`; twice the time, no pairs);
+        1 ranks once and tries pairs.  Budget keys: ``n_seeds``, ``n_null``, ``grid``,
+        ``refine``, ``pairs``, ``n_pair_candidates``.
 
     Returns
     -------
@@ -976,14 +976,14 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     t = _time.perf_counter()
     names = list(effects) if effects else (list(QUICK_EFFECTS) if quick else None)
     cands = candidates(names)
-    kw = dict(n_seeds=3, n_null=6, grid=3, refine=3, pairs=False) if quick else \
-        dict(n_seeds=4, n_null=12, grid=4, refine=4, pairs=True, n_pair_candidates=2)
+    kw = dict(n_seeds=3, n_null=6, grid=3, refine=3, pairs=False, folds=1) if quick else \
+        dict(n_seeds=4, n_null=12, grid=4, refine=4, n_pair_candidates=2, folds=2)
     kw.update(settings or {})
     folds = int(kw.pop("folds", 1))
     if folds not in (1, 2):
         raise EroadInputError(f"folds must be 1 or 2, got {folds}")
-    if folds == 2:
-        kw["pairs"] = False            # pairs are calibrated per fold; not combined
+    # pairs are calibrated per fold and not combined: one fold tries them by default
+    kw["pairs"] = bool(kw.get("pairs", True)) and folds == 1
     fit, simulate = Fit(model), Simulate(model)
     progress(f"ranking {len(cands)} candidate effect(s) on {len(calib)} calibration + "
              f"{len(held)} held-out windows ({workers} worker(s)"
