@@ -83,11 +83,11 @@ QUANTITIES = ("susp_disp_", "axle_acc_", "body_acc_")
 RAMP_S = 0.5
 #: pieces shorter than this take the level of the whole window [s]
 MIN_PIECE_S = 1.5
-#: nonlinear candidates (bump stop, leaf friction, damper asymmetry) are simulated on the
-#: road the nominal model's level fit gives the window (the same seed's nominal run
-#: re-levelled per segment piece, its factors squared into Gq), then re-levelled as every
-#: model is: an amplitude-dependent effect must see the road amplitude the truck saw, not
-#: the calibration fit's (a bump stop simulated at a level 30 % low never engages)
+#: nonlinear candidates (bump stop, leaf friction, damper asymmetry) are simulated twice:
+#: on the fitted road, then on the road at which that run matches the measured level piece
+#: by piece (factors squared into Gq), then re-levelled as every model is: an
+#: amplitude-dependent effect must see the road amplitude the truck saw, not the
+#: calibration fit's (a bump stop simulated at a level 30 % low never engages)
 PRE_LEVEL = True
 #: the skewness of the suspension displacements is a term of every gap (``shape_term``,
 #: :class:`diagnosis.which.ShapeTerm`): what separates a bump stop from a payload error
@@ -353,7 +353,14 @@ class TruckModel:
             return self._roads[key]
         tau, v, s, x_start, x_ref, t_rec, n_run, n = self._plan(t0, t1)
         length = x_start + s[-1] / SPEED_FACTOR_MIN + 3.0
-        xb = np.interp(self.bounds[1:-1], t_rec, x_ref)
+        # boundaries outside the drive go where the truck would meet them at its first /
+        # last speed (clamping them to the window's ends put the next segment under the
+        # front axles before the window ended: a class-F segment 19 s later drove the last
+        # 0.4 s of a class-A window)
+        tb = np.asarray(self.bounds[1:-1], float)
+        xb = np.interp(tb, t_rec, x_ref)
+        xb = np.where(tb > t_rec[-1], x_ref[-1] + v[-1] * (tb - t_rec[-1]), xb)
+        xb = np.where(tb < t_rec[0], x_ref[0] - v[0] * (t_rec[0] - tb), xb)
         edges = np.concatenate([[0.0], np.clip(xb, 0.0, length), [length]])
         segs, k_used = [], []
         for k in range(len(gq)):
@@ -494,28 +501,22 @@ class Simulate:
 
     def __init__(self, model: TruckModel):
         self.model = model
-        self._pre = {}
 
-    def __getstate__(self):
-        return {"model": self.model, "_pre": {}}
-
-    def prelevel_gq(self, w: Signals, t0: float, t1: float, seed: int) -> np.ndarray:
-        """Per-segment Gq of window [t0, t1) and road seed ``seed`` at which the nominal
-        model matches the measured level piece by piece (``PRE_LEVEL``); cached."""
+    def prelevel_gq(self, w: Signals, t0: float, t1: float, seed: int, effects=None,
+                    sim=None) -> np.ndarray:
+        """Per-segment Gq of window [t0, t1) and road seed ``seed`` at which the model with
+        ``effects`` matches the measured level piece by piece (``PRE_LEVEL``): its run on
+        the fitted road (``sim`` when already made), tilted, re-levelled per piece, the
+        factors squared into Gq."""
         m = self.model
-        key = (round(t0, 6), round(t1, 6), int(seed))
-        gq = self._pre.get(key)
-        if gq is None:
-            nom = m.run({}, t0, t1, seed)
-            if TILT_REFIT:
-                nom = apply_tilt(nom, m.fs, window_tilt(w.channels, nom, m.fs, m.noise))
-            _, vals = piece_levels(m, w.channels, nom, t0, t1, m.noise)
-            gq = np.array(m.gq, float)
-            for (k, _a, _b), (_a2, _b2, f) in zip(m.pieces(t0, t1), vals):
-                gq[k] *= f * f
-            if len(self._pre) > 256:
-                self._pre.clear()
-            self._pre[key] = gq
+        if sim is None:
+            sim = m.run(effects or {}, t0, t1, seed)
+        if TILT_REFIT:
+            sim = apply_tilt(sim, m.fs, window_tilt(w.channels, sim, m.fs, m.noise))
+        _, vals = piece_levels(m, w.channels, sim, t0, t1, m.noise)
+        gq = np.array(m.gq, float)
+        for (k, _a, _b), (_a2, _b2, f) in zip(m.pieces(t0, t1), vals):
+            gq[k] *= f * f
         return gq
 
     def __call__(self, state, window, seed):
@@ -527,7 +528,12 @@ class Simulate:
         t1 = t0 + w.time.size / m.fs
         gq = None
         if PRE_LEVEL and any(EFFECTS[n].nonlinear for n in state.effects if n in EFFECTS):
-            gq = self.prelevel_gq(w, t0, t1, seed)
+            try:
+                gq = self.prelevel_gq(w, t0, t1, seed, state.effects)
+            except Exception as exc:  # noqa: BLE001 - scored as a diverging model below
+                from eroad.errors import SimulationError
+                if not isinstance(exc, SimulationError):
+                    raise
         try:
             sim = m.run(state.effects, t0, t1, seed, gq=gq)
         except Exception as exc:  # a diverging candidate scores as a very bad model

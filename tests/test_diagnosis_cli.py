@@ -148,7 +148,8 @@ def test_prelevel_gives_nonlinear_candidates_the_measured_road_level(short_drive
     nonlinearity, ~1e-4, and the tilt refit, exactly 0 for a scaled copy, separate them;
     tolerance 1 %; noise floor set to 0, else the level is that of measured power less
     the noise power).  Linear candidates are not pre-levelled (re-levelling afterwards is
-    exact for them), nonlinear ones drive the pre-levelled road."""
+    exact for them); a nonlinear one runs on the fitted road, then on the road its own run
+    levels to."""
     import dataclasses
 
     import numpy as np
@@ -165,7 +166,7 @@ def test_prelevel_gives_nonlinear_candidates_the_measured_road_level(short_drive
     w = Signals(np.arange(n) / m.fs + t0, {c: 2.0 * x for c, x in nom.items()}, {},
                 np.interp(np.arange(n) / m.fs + t0, sig.time, sig.speed), {"t0": t0})
     sim = Simulate(m)
-    gq = sim.prelevel_gq(w, t0, t1, 5)
+    gq = sim.prelevel_gq(w, t0, t1, 5, {})
     for k, a, b in m.pieces(t0, t1):
         assert gq[k] / m.gq[k] == pytest.approx(4.0, rel=0.01)
     calls = []
@@ -178,5 +179,34 @@ def test_prelevel_gives_nonlinear_candidates_the_measured_road_level(short_drive
     m.run = spy
     sim(State({"payload": {"mass": 1000.0}}), w, 5)
     sim(State({"bump_stop": {"gap": 0.03}}), w, 5)
-    assert calls[0] is None
-    np.testing.assert_allclose(calls[1], gq)
+    assert calls[:2] == [None, None] and calls[2] is not None   # the bump stop runs twice
+    b = sim.prelevel_gq(w, t0, t1, 5, {"bump_stop": {"gap": 0.03}})
+    np.testing.assert_allclose(calls[2], b)
+
+
+def test_window_road_has_no_segment_the_truck_does_not_reach(short_drive):
+    """``TruckModel._road``: a boundary after the window lies where the truck would meet it,
+    not at the window's end.  Before the fix it was clamped to the end of the drive, so the
+    front axles ran onto the next segment for the last ~0.4 s of the window (null drive
+    1106: a class-F segment 19 s later made the class-A windows' simulated power 5x too
+    high).  Here: segments 1e-6 and 1e-2 m^3 (factor 1e4 in power, 100 in height), the
+    boundary 10 s after a 0-6 s window: the window's road is all smooth (rms below 3x
+    that of the smooth class alone: its realisation scatters, the rough one would be
+    ~100x); a boundary 0.3 s after the window end is still on the road."""
+    import dataclasses
+
+    import numpy as np
+
+    from diagnosis.pipeline import load_measured, prepare
+
+    drive, sig = load_measured(short_drive)
+    ctx = prepare(sig, drive.vehicle, workers=1)
+    m = dataclasses.replace(ctx.model, bounds=np.array([0.0, 16.0, sig.duration]),
+                            gq=np.array([1e-6, 1e-2]), w=np.array([2.0, 2.0]), _roads={})
+    smooth = dataclasses.replace(m, bounds=np.array([0.0, sig.duration]), gq=np.array([1e-6]),
+                                 w=np.array([2.0]), _roads={})
+    r = m._road(0.0, 6.0, 3, m.gq)
+    r0 = smooth._road(0.0, 6.0, 3, smooth.gq)
+    assert np.std(r.z) < 3.0 * np.std(r0.z)
+    m2 = dataclasses.replace(m, bounds=np.array([0.0, 6.3, sig.duration]), _roads={})
+    assert np.std(m2._road(0.0, 6.0, 3, m2.gq).z) > 10.0 * np.std(r0.z)
