@@ -573,12 +573,14 @@ class DelayTerm(WindowTerm):
     """Front-to-rear delay mismatch as a term of the gap (road-independent; what identifies
     a speed-signal scale error, which the road level otherwise absorbs).
 
-    Per window, the delay of each rear channel behind its front channel
-    (:func:`diagnosis.compare.gcc_delay`, SCOT-weighted GCC in ``f_lo``-``f_hi``) is
-    computed on the simulated and the measured window; ``rho_j`` is the mean over the
-    pairs of ``ln(tau_sim / tau_meas)`` (same window, same recorded speed: the speed
-    cancels; the median over the pairs, so that a wrong GCC peak in one pair does not
-    count).  ``z`` is the inverse-variance weighted mean of ``rho_j`` over the windows divided
+    Per window, the lag of each rear channel behind its front channel in recorded
+    distance (:meth:`log_delays`: both resampled onto the distance integrated from the
+    recorded speed, then :func:`diagnosis.compare.gcc_delay`, SCOT-weighted GCC in
+    ``f_lo``-``f_hi`` Hz mapped to cycles/m) is computed on the simulated and the measured
+    window; it is ``factor * d`` for a speed-signal scale ``factor``, however the speed
+    varies.  ``rho_j`` is the median over the pairs of ``ln(tau_sim / tau_meas)`` (same
+    window, same recorded speed: the speed cancels; the median, so that a wrong GCC peak
+    in one pair does not count).  ``z`` is the inverse-variance weighted mean of ``rho_j`` over the windows divided
     by its standard error, with ``var rho_j = 2 sigma_j^2``: ``sigma_j`` the road-phase
     standard deviation of window ``j``'s statistic, estimated from nominal simulations of
     that window over several seeds (:meth:`prepare`, separately for the calibration and the
@@ -598,13 +600,22 @@ class DelayTerm(WindowTerm):
     _meas: dict = field(default_factory=dict, repr=False)
     _sigma: dict = field(default_factory=dict, repr=False)
 
-    #: delay search per pair and window: LAG_LO x the shortest to LAG_HI x the longest
-    #: kinematic delay ``distance / speed`` of the window (covers speed scales 0.7-1.4)
+    #: lag search per pair: LAG_LO to LAG_HI x the axle distance, in recorded distance
+    #: (covers speed factors 0.7-1.4)
     LAG_LO, LAG_HI = 0.7, 1.4
 
     def log_delays(self, windows) -> np.ndarray:
-        """``ln tau`` per window and pair, (W, P) array (NaN where no delay: no speed, or the
-        delay range does not fit the window's GCC segment)."""
+        """``ln`` of the rear channel's lag behind the front one in RECORDED DISTANCE (m) per
+        window and pair, (W, P) array (NaN where no delay: no speed, or the lag range does
+        not fit the window's GCC segment).
+
+        Both channels are resampled onto a uniform grid of the recorded distance
+        ``s(t) = int v dt`` (spacing ``v_min / fs``, no downsampling) before the GCC: in
+        distance the lag is ``factor * d`` whatever the speed does, while in time it runs
+        from ``d / v_max`` to ``d / v_min`` through a window whose speed changes, which
+        smears the correlation peak (blind case 26: 7-12 m/s in one 7.5 s window, time
+        delays of one pair 0.29-0.46 s).  The band ``f_lo``-``f_hi`` (Hz) becomes
+        ``f / v_mean`` cycles/m."""
         from .compare import gcc_delay
         from .signals import as_signals
 
@@ -613,23 +624,29 @@ class DelayTerm(WindowTerm):
             s = as_signals(w)
             if s.speed is None or not np.all(np.asarray(s.speed) > 0.5):
                 continue
-            inv = 1.0 / np.asarray(s.speed, float)
-            n = s.time.size
+            v = np.asarray(s.speed, float)
+            dist = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) / s.fs)])
+            ds = float(v.min()) / s.fs
+            grid = np.arange(0.0, dist[-1], ds)
+            fs_x, v_mean = 1.0 / ds, float(v.mean())
+            n = grid.size
             L = int(2 ** np.floor(np.log2(max(16, n // 2))))        # gcc_delay's longest segment
             for k, ((a, b), d) in enumerate(zip(self.pairs, self.distances)):
                 if a not in s.channels or b not in s.channels:
                     continue
-                lo, hi = self.LAG_LO * d * inv.min(), self.LAG_HI * d * inv.max()
-                if hi * s.fs > L // 2 - 2:
+                lo, hi = self.LAG_LO * d, self.LAG_HI * d
+                if hi * fs_x > L // 2 - 2:
                     continue
-                tau = gcc_delay(s.channels[a], s.channels[b], s.fs, max_lag=hi, min_lag=lo,
-                                f_lo=self.f_lo, f_hi=self.f_hi)
-                if np.isfinite(tau) and tau > 0:
-                    out[j, k] = math.log(tau)
+                xa = np.interp(grid, dist, np.asarray(s.channels[a], float))
+                xb = np.interp(grid, dist, np.asarray(s.channels[b], float))
+                lag = gcc_delay(xa, xb, fs_x, max_lag=hi, min_lag=lo,
+                                f_lo=self.f_lo / v_mean, f_hi=self.f_hi / v_mean)
+                if np.isfinite(lag) and lag > 0:
+                    out[j, k] = math.log(lag)
         return out
 
-    #: floor of the per-window standard deviation of ``ln tau`` (GCC peak interpolation,
-    #: about a third of a sample at 200 Hz on a 0.5 s delay)
+    #: floor of the per-window standard deviation of ``ln tau`` (GCC peak interpolation:
+    #: about a third of a grid step, 0.01-0.02 m at 6-12 m/s and 200 Hz, on a 3-6 m lag)
     SIGMA_FLOOR = 0.003
     label = "delay"
 
