@@ -293,6 +293,48 @@ def gcc_delay(x: np.ndarray, y: np.ndarray, fs: float, *, max_lag: float, f_lo: 
     return float((k + np.clip(off, -0.5, 0.5)) / fs)
 
 
+def distance_lag(x: np.ndarray, y: np.ndarray, speed: np.ndarray, fs: float, *,
+                 max_lag: float, min_lag: float = 0.0, f_lo: float = 1.0, f_hi: float = 30.0,
+                 strict: bool = False) -> float:
+    """Lag of ``y`` behind ``x`` in RECORDED DISTANCE (m): both resampled onto a uniform grid
+    of ``s(t) = integral of speed`` (step ``min(speed) / fs``: no sample is dropped), then
+    :func:`gcc_delay` with ``f_lo``-``f_hi`` (Hz) mapped to ``f / mean(speed)`` cycles/m.
+
+    Two axles ``d`` apart see the same road ``d`` apart in true distance, so the lag is
+    ``factor * d`` for a speed signal reading ``factor`` x the true speed, whatever the
+    speed does; a delay in time runs from ``d / v_max`` to ``d / v_min`` through a record
+    whose speed changes and smears the correlation peak.
+
+    Parameters
+    ----------
+    x, y : (N,) arrays
+    speed : (N,) array, m/s
+        Recorded speed, > 0 throughout (else NaN is returned).
+    fs : float, Hz
+    max_lag, min_lag : float, m
+        Search range.
+    strict : bool
+        NaN when ``max_lag`` does not fit the longest GCC segment of the record (instead of
+        searching the part that fits).
+    """
+    v = np.asarray(speed, float)
+    if v.size != np.size(x) or not np.all(v > 0):
+        return float("nan")
+    dist = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) / fs)])
+    ds = float(v.min()) / fs
+    grid = np.arange(0.0, dist[-1], ds)
+    fs_x = 1.0 / ds
+    if strict:
+        L = int(2 ** np.floor(np.log2(max(16, grid.size // 2))))     # gcc_delay's longest segment
+        if max_lag * fs_x > L // 2 - 2:
+            return float("nan")
+    v_mean = float(v.mean())
+    xa = np.interp(grid, dist, np.asarray(x, float))
+    xb = np.interp(grid, dist, np.asarray(y, float))
+    return gcc_delay(xa, xb, fs_x, max_lag=max_lag, min_lag=min_lag, f_lo=f_lo / v_mean,
+                     f_hi=f_hi / v_mean)
+
+
 @dataclass(frozen=True)
 class FrontRear:
     """Front-to-rear coherence and delay, measured against simulated.
@@ -306,9 +348,10 @@ class FrontRear:
     z_diff, se, ci_lo, ci_hi, p_value, significant : (npair, nb) arrays
         Difference of Fisher z (sim - meas), FCR-adjusted interval, BH flags.
     delay_meas, delay_sim : (npair,) arrays, s
-        Whole-record GCC delay.
+        Whole-record GCC delay; with speed signals the lag in recorded distance
+        (:func:`distance_lag`) over the mean recorded speed.
     delay_expected : float, s
-        ``mean(wheelbase / speed)`` (NaN without wheelbase or speed).
+        ``wheelbase / mean(speed)`` (NaN without wheelbase or speed).
     delay_ratio, delay_ratio_lo, delay_ratio_hi : (npair,) arrays
         Measured / simulated delay, mean over blocks with t-interval (95 %).
     speed_scale, speed_scale_lo, speed_scale_hi : (npair,) arrays
@@ -436,11 +479,28 @@ def front_rear(measured, simulated, *, front: str = "1", rear: str = "3",
         raise EroadInputError(f"front_rear: no {quantity} pair of axles {front} and {rear} in both records")
     bands = third_octave_bands() if bands is None else np.asarray(bands, dtype=float)
     speed = meas.speed
+    # with a speed signal on both records the lags are taken in recorded distance
+    # (:func:`distance_lag`, no smearing while the speed changes) and reported as delays over
+    # the record's (block's) mean recorded speed; without one, in time
+    ssp = sim.speed if sim.speed is not None else speed
+    in_dist = (speed is not None and ssp is not None and np.all(np.asarray(speed) > 0)
+               and np.all(np.asarray(ssp) > 0) and np.size(ssp) == sim.time.size)
     expected = float("nan")
-    if wheelbase is not None and speed is not None and np.all(speed > 0):
-        expected = float(np.mean(wheelbase / speed))
+    if wheelbase is not None and in_dist:
+        expected = float(wheelbase / np.mean(speed))
     if max_lag is None:
         max_lag = 2 * wheelbase / float(np.min(speed)) if np.isfinite(expected) else 2.0
+
+    def lag(s, v, a, b, i0=0, i1=None):
+        """Delay (s) of channel b behind a on samples i0:i1 of record s with speed v."""
+        x, y = s.channels[a][i0:i1], s.channels[b][i0:i1]
+        if not in_dist:
+            return gcc_delay(x, y, s.fs, max_lag=max_lag, f_lo=f_lo, f_hi=f_hi)
+        vb = np.asarray(v, float)[i0:i1]
+        vm = float(vb.mean())
+        # the time search range at the block's slowest speed, as a distance at its mean
+        return distance_lag(x, y, vb, s.fs, max_lag=max_lag * float(vb.min()), f_lo=f_lo,
+                            f_hi=f_hi) / vm
     Z = {"m": [], "s": []}
     V = {"m": [], "s": []}
     dm, ds, rr, rlo, rhi, sc, sclo, schi, dsig = ([] for _ in range(9))
@@ -452,17 +512,15 @@ def front_rear(measured, simulated, *, front: str = "1", rear: str = "3",
             z, v = _fisher_band(s.channels[a], s.channels[b], s.fs, bands, Ls)
             Z[tag].append(z)
             V[tag].append(v)
-        kw = dict(max_lag=max_lag, f_lo=f_lo, f_hi=f_hi)
-        dm.append(gcc_delay(meas.channels[a], meas.channels[b], meas.fs, **kw))
-        ds.append(gcc_delay(sim.channels[a], sim.channels[b], sim.fs, **kw))
+        dm.append(lag(meas, speed, a, b))
+        ds.append(lag(sim, ssp, a, b))
         ratios, scales = [], []
         n = min(meas.time.size, sim.time.size)
         for i0, i1 in _blocks(n, n_blocks):
-            tm = gcc_delay(meas.channels[a][i0:i1], meas.channels[b][i0:i1], meas.fs, **kw)
-            ts = gcc_delay(sim.channels[a][i0:i1], sim.channels[b][i0:i1], sim.fs, **kw)
+            tm, ts = lag(meas, speed, a, b, i0, i1), lag(sim, ssp, a, b, i0, i1)
             ratios.append(tm / ts)
             if np.isfinite(expected):
-                scales.append(float(np.mean(wheelbase / speed[i0:i1])) / tm)
+                scales.append(wheelbase / float(np.mean(speed[i0:i1])) / tm)
         ratios = np.array(ratios)
         ratios = ratios[np.isfinite(ratios)]
         if ratios.size >= 2:

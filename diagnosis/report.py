@@ -353,9 +353,10 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
             L.append(f"![transmissibility]({figures['transmissibility']})\n")
     FR = summary.get("front_rear")
     if FR:
-        L.append("**Front-to-rear delay** (GCC-SCOT; measured/simulated ratio with 95 % interval "
-                 "over time blocks; apparent speed scale = expected delay wheelbase/speed over "
-                 "measured delay):\n")
+        L.append("**Front-to-rear delay** (GCC-SCOT of the lag in recorded distance, shown as a "
+                 "delay at the mean recorded speed; measured/simulated ratio with 95 % interval "
+                 "over time blocks; apparent speed scale (true / recorded) = expected delay "
+                 "wheelbase/speed over measured delay):\n")
         L.append("| front | rear | delay meas [s] | delay sim [s] | expected [s] | meas/sim "
                  "| apparent speed scale | flagged |")
         L.append("|---|---|---|---|---|---|---|---|")

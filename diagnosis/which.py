@@ -609,14 +609,11 @@ class DelayTerm(WindowTerm):
         window and pair, (W, P) array (NaN where no delay: no speed, or the lag range does
         not fit the window's GCC segment).
 
-        Both channels are resampled onto a uniform grid of the recorded distance
-        ``s(t) = int v dt`` (spacing ``v_min / fs``, no downsampling) before the GCC: in
-        distance the lag is ``factor * d`` whatever the speed does, while in time it runs
-        from ``d / v_max`` to ``d / v_min`` through a window whose speed changes, which
-        smears the correlation peak (blind case 26: 7-12 m/s in one 7.5 s window, time
-        delays of one pair 0.29-0.46 s).  The band ``f_lo``-``f_hi`` (Hz) becomes
-        ``f / v_mean`` cycles/m."""
-        from .compare import gcc_delay
+        :func:`diagnosis.compare.distance_lag` (both channels resampled onto the recorded
+        distance): the lag is ``factor * d`` whatever the speed does, where a delay in time
+        smears while the speed changes (blind case 26: 7-12 m/s in one 7.5 s window, time
+        delays of one pair 0.29-0.46 s)."""
+        from .compare import distance_lag
         from .signals import as_signals
 
         out = np.full((len(windows), len(self.pairs)), np.nan)
@@ -624,23 +621,12 @@ class DelayTerm(WindowTerm):
             s = as_signals(w)
             if s.speed is None or not np.all(np.asarray(s.speed) > 0.5):
                 continue
-            v = np.asarray(s.speed, float)
-            dist = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) / s.fs)])
-            ds = float(v.min()) / s.fs
-            grid = np.arange(0.0, dist[-1], ds)
-            fs_x, v_mean = 1.0 / ds, float(v.mean())
-            n = grid.size
-            L = int(2 ** np.floor(np.log2(max(16, n // 2))))        # gcc_delay's longest segment
             for k, ((a, b), d) in enumerate(zip(self.pairs, self.distances)):
                 if a not in s.channels or b not in s.channels:
                     continue
-                lo, hi = self.LAG_LO * d, self.LAG_HI * d
-                if hi * fs_x > L // 2 - 2:
-                    continue
-                xa = np.interp(grid, dist, np.asarray(s.channels[a], float))
-                xb = np.interp(grid, dist, np.asarray(s.channels[b], float))
-                lag = gcc_delay(xa, xb, fs_x, max_lag=hi, min_lag=lo,
-                                f_lo=self.f_lo / v_mean, f_hi=self.f_hi / v_mean)
+                lag = distance_lag(s.channels[a], s.channels[b], s.speed, s.fs,
+                                   max_lag=self.LAG_HI * d, min_lag=self.LAG_LO * d,
+                                   f_lo=self.f_lo, f_hi=self.f_hi, strict=True)
                 if np.isfinite(lag) and lag > 0:
                     out[j, k] = math.log(lag)
         return out

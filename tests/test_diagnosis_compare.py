@@ -102,3 +102,37 @@ def test_distribution_shape_sees_a_cubic_spring_and_not_noise():
     n_any = sum(distribution_shape(_drive(nom, 10 + k, 40.0), _drive(nom, 20 + k, 40.0)).significant.any()
                 for k in range(8))
     assert n_any <= 1
+
+
+def test_front_rear_speed_scale_while_the_speed_changes():
+    """Truck speeding up from 7 to 12 m/s over 30 s, axles 5 m apart, the speed signal
+    reading 0.93 x the true speed: the apparent speed scale (true / recorded) is 1/0.93
+    within 0.5 % with an interval that excludes 1 (the lags are taken in recorded distance,
+    :func:`diagnosis.compare.distance_lag`; as delays in time the scale came out 1.10 and
+    5.3 on the two sides of a blind case like this).  Against a correct speed signal the
+    delay ratio interval contains 1."""
+    from diagnosis.compare import distance_lag
+    from diagnosis.signals import Signals
+
+    fs, T, d = 200.0, 30.0, 5.0
+    t = np.arange(int(T * fs)) / fs
+    x = 10.0 + 7.0 * t + 2.5 * t ** 2 / T                      # true distance, 7 -> 12 m/s
+    v_true = 7.0 + 5.0 * t / T
+    rng = np.random.default_rng(5)
+    n = np.linspace(0.1, 3.0, 300)
+    amp, ph = n ** -1.0, rng.uniform(0, 2 * np.pi, n.size)
+
+    def road(xx):
+        return np.sin(2 * np.pi * np.outer(xx, n) + ph) @ amp
+
+    ch = {"axle_acc_1L": road(x), "axle_acc_3L": road(x - d)}
+    right = Signals(t, ch, speed=v_true)
+    wrong = Signals(t, ch, speed=0.93 * v_true)
+    assert distance_lag(ch["axle_acc_1L"], ch["axle_acc_3L"], 0.93 * v_true, fs,
+                        max_lag=2 * d) == pytest.approx(0.93 * d, rel=0.005)
+    fr = front_rear(wrong, right, wheelbase=d, sides=("L",))
+    assert fr.speed_scale[0] == pytest.approx(1 / 0.93, rel=0.005)
+    assert fr.speed_scale_lo[0] > 1.0
+    fr0 = front_rear(right, right, wheelbase=d, sides=("L",))
+    assert fr0.speed_scale[0] == pytest.approx(1.0, rel=0.005)
+    assert fr0.delay_ratio_lo[0] <= 1.0 <= fr0.delay_ratio_hi[0]
