@@ -520,6 +520,7 @@ class Simulate:
         return gq
 
     def __call__(self, state, window, seed):
+        from eroad.errors import SimulationError
         from vehicles.effects import EFFECTS
 
         w = as_signals(window)
@@ -530,18 +531,12 @@ class Simulate:
         if PRE_LEVEL and any(EFFECTS[n].nonlinear for n in state.effects if n in EFFECTS):
             try:
                 gq = self.prelevel_gq(w, t0, t1, seed, state.effects)
-            except Exception as exc:  # noqa: BLE001 - scored as a diverging model below
-                from eroad.errors import SimulationError
-                if not isinstance(exc, SimulationError):
-                    raise
+            except SimulationError:     # the scored run below diverges too, or runs unlevelled
+                pass
         try:
             sim = m.run(state.effects, t0, t1, seed, gq=gq)
-        except Exception as exc:  # a diverging candidate scores as a very bad model
-            from eroad.errors import SimulationError
-            if not isinstance(exc, SimulationError):
-                raise
-            sim = {c: np.zeros(w.time.size) for c in m.channels}
-            sim = {c: x + 1e3 for c, x in sim.items()}
+        except SimulationError:         # a diverging candidate scores as a very bad model
+            sim = {c: np.full(w.time.size, 1e3) for c in m.channels}
         # nuisances profiled per model and window: the road waviness (a spectral tilt, see
         # window_tilt), the level with the
         # nominal noise floor, then the white-noise floor of THIS model (measured minus

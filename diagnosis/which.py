@@ -580,15 +580,9 @@ class DelayTerm(WindowTerm):
     window; it is ``factor * d`` for a speed-signal scale ``factor``, however the speed
     varies.  ``rho_j`` is the median over the pairs of ``ln(tau_sim / tau_meas)`` (same
     window, same recorded speed: the speed cancels; the median, so that a wrong GCC peak
-    in one pair does not count).  ``z`` is the inverse-variance weighted mean of ``rho_j`` over the windows divided
-    by its standard error, with ``var rho_j = 2 sigma_j^2``: ``sigma_j`` the road-phase
-    standard deviation of window ``j``'s statistic, estimated from nominal simulations of
-    that window over several seeds (:meth:`prepare`, separately for the calibration and the
-    held-out set); the measured side is taken to have the same sampling noise.
-    The gap term is ``weight * z^2``; :func:`rank_effects` sets ``weight`` so that the term's
-    standard deviation under a correct model (``weight sqrt 2``, ``z^2 ~ chi2(1)``) is half
-    the standard deviation of the nominal-vs-nominal band gap.  Only a model that changes
-    the axle-to-axle delay (a speed scale) changes ``z``; with common random numbers the
+    in one pair does not count).  ``z``, ``sigma_j`` and the weight as in
+    :class:`WindowTerm`.  Only a model that changes the axle-to-axle lag (a speed scale)
+    changes ``z``; with common random numbers the
     term is the same for every other model.
     """
 
