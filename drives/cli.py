@@ -96,6 +96,7 @@ def format_summary(s: dict) -> str:
         f"({'speed column' if s['speed_source'] == 'column' else 'constant from meta.toml'})",
         f"vehicle   {s['vehicle']}{' (file in the dataset)' if s['vehicle_is_file'] else ''}",
     ]
+    lines += [f"warning   {w}" for w in s.get("warnings", [])]
     return "\n".join(lines)
 
 

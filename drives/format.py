@@ -186,6 +186,9 @@ class Drive:
         Channel name -> unit (always SI: ``m``, ``m/s^2``, ``m/s``).
     speed_source : str
         ``"column"`` or ``"meta"``.
+    warnings : tuple of str
+        Plausibility findings that do not refuse the data (``drives.plausibility``):
+        one line each, naming the file and column.
     """
 
     path: Path
@@ -196,6 +199,7 @@ class Drive:
     vehicle: str | Path
     units: dict = field(default_factory=dict)
     speed_source: str = "column"
+    warnings: tuple = ()
 
     @property
     def name(self) -> str:
@@ -300,6 +304,7 @@ class Drive:
             "speed_source": self.speed_source,
             "vehicle": veh,
             "vehicle_is_file": isinstance(self.vehicle, Path),
+            "warnings": list(self.warnings),
         }
 
 
@@ -726,10 +731,20 @@ def inspect_drive(folder) -> tuple[list[str], Drive | None]:
         speed, source = np.full(t.size, speed_mps), "meta"
     for c in chans.columns:
         units.setdefault(c, QUANTITIES[parse_channel(c)[0]].unit)
+    from drives.plausibility import check_units as _physics
+
+    warnings = []
+    for f in _physics({c: chans[c].to_numpy(float) for c in chans.columns}, 1.0 / step):
+        if f.fatal:
+            probs.add(csv, f.message, column=f.column)
+        else:
+            warnings.append(f"{CHANNELS_FILE}, column '{f.column}': {f.message}")
+    if probs.items:
+        return probs.items, None
     meta = dict(ds)
     meta.setdefault("name", folder.name)
     return [], Drive(path=folder, time=t, channels=chans, speed=speed, meta=meta,
-                     vehicle=vehicle, units=units, speed_source=source)
+                     vehicle=vehicle, units=units, speed_source=source, warnings=tuple(warnings))
 
 
 def check_drive(path) -> list[str]:
