@@ -77,7 +77,14 @@ def score_case(truth: dict, summary: dict) -> dict:
                      "class_fit": class_of(f["Gq_n0"]),
                      # the PSD at 1 cycle/m (~10 Hz at 10 m/s, where the truck responds)
                      "dlnG_1cpm": abs(math.log(f["Gq_n0"] / s["Gq_n0"]) - (f["w"] - s["w"]) * math.log(10.0)),
+                     # signed errors and what the fit reported, for the interval calibration
+                     "lnGq_err": math.log(f["Gq_n0"] / s["Gq_n0"]), "w_err": f["w"] - s["w"],
+                     "sd_ln_Gq_n0": f["sd"]["ln_Gq_n0"], "sd_w": f["sd"]["w"],
+                     "objective": f.get("objective"), "n_features": f.get("n_features"),
+                     "fit_duration_s": f["t_end"] - f["t_start"],
+                     **({"interval": f["interval"]} if "interval" in f else {}),
                      **({"n_best": f["n_best"], "sd_ln_G_n_best": f["sd_ln_G_n_best"],
+                         "lnG_n_best_err": math.log(f["G_n_best"] / (s["Gq_n0"] * (f["n_best"] / 0.1) ** -s["w"])),
                          "dlnG_n_best": abs(math.log(f["G_n_best"] / (s["Gq_n0"] * (f["n_best"] / 0.1) ** -s["w"])))}
                         if "n_best" in f else {})})
     berr = segment_errors(tt, tf)

@@ -130,7 +130,8 @@ def select_realisation(simulate, params, measured: dict, seeds, *, channels=SELE
         mismatch_L, mismatch_R, rms_err and mean_abs_err per table channel),
         ``spread`` (per table channel: median, 16th and 84th percentile, median
         and largest |error| of rms_err over the candidates -- the statistical
-        floor of one random-phase realisation).
+        floor of one random-phase realisation -- their number ``n``, and the
+        median, 16th and 84th percentile of mean_abs_err as ``mean_abs_*``).
     """
     seeds = [int(s) for s in seeds]
     labels = [str(s) for s in seeds] if labels is None else [str(x) for x in labels]
@@ -149,9 +150,12 @@ def select_realisation(simulate, params, measured: dict, seeds, *, channels=SELE
     for c in table_channels:
         e = np.array([cd["rms_err"][c] for cd in cands if c in cd["rms_err"]])
         if e.size:
+            a = np.array([cd["mean_abs_err"][c] for cd in cands if c in cd["mean_abs_err"]])
             spread[c] = {"median": float(np.median(e)), "p16": float(np.percentile(e, 16)),
                          "p84": float(np.percentile(e, 84)), "max_abs": float(np.max(np.abs(e))),
-                         "median_abs": float(np.median(np.abs(e)))}
+                         "median_abs": float(np.median(np.abs(e))), "n": int(e.size),
+                         "mean_abs_median": float(np.median(a)), "mean_abs_p16": float(np.percentile(a, 16)),
+                         "mean_abs_p84": float(np.percentile(a, 84))}
     i = int(np.argmin([c["mismatch"] for c in cands]))
     out = {"index": i, "seed": seeds[i], "label": labels[i], "simulated": sims[i], "candidates": cands,
            "spread": spread, "sides": False}

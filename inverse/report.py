@@ -47,37 +47,71 @@ def table1(segments: list) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+#: unit of each Table 2 quantity by channel prefix
+_UNITS = {"axle_acc": "m/s^2", "body_acc": "m/s^2", "susp_disp": "m"}
+
+#: the note written under Table 2 (markdown)
+TABLE2_NOTE = (
+    "Headline: the median over the road realisations (random phases) of the fitted spectra, "
+    "with the 16-84 % range over them; one realisation's RMS scatters by several per cent, so "
+    "a single one is no measure of the fit. rect_mean is the rectified mean, mean |y - mean y| "
+    "(the paper's 'mean acceleration': a gravity-free acceleration has zero mean). The "
+    "'selected_' columns belong to the one realisation kept for the road files and Figures 8-9, "
+    "chosen by its RMS nearness to the measurement: they are not an independent check. "
+    "Errors are (simulated - measured) / measured in %; rmse_eq6_norm is eq 6's RMSE over the "
+    "measured RMS (about 1.4 for two signals of unrelated phase); W1_over_sd is the "
+    "Wasserstein-1 distance of the amplitude distributions over the measured sd.")
+
+
 def table2(rows: list, spread: dict | None = None) -> pd.DataFrame:
-    """Table 2: RMS and mean (rectified) of the responses, measured and simulated.
+    """Table 2: response RMS and rectified mean, measured and simulated.
 
     Parameters
     ----------
     rows : list of dict
         :func:`inverse.validation.response_table` rows of the selected realisation.
     spread : dict, optional
-        Per channel RMS-error spread over the candidate realisations
-        (:func:`inverse.realisation.select_realisation`).
+        Per channel error spread over the candidate realisations
+        (:func:`inverse.realisation.select_realisation`); where given, the headline
+        columns are its medians and 16-84 % ranges (see :data:`TABLE2_NOTE`).
 
     Returns
     -------
     DataFrame
+        channel, unit, rms_meas [unit], then over realisations rms_sim_median [unit],
+        rms_err_median_pct, rms_err_p16_pct, rms_err_p84_pct, rect_mean_meas [unit],
+        rect_mean_err_median_pct, rect_mean_err_p16_pct, rect_mean_err_p84_pct,
+        n_realisations, then the selected realisation's selected_rms_sim [unit],
+        selected_rms_err_pct, selected_rect_mean_err_pct, selected_rmse_eq6_norm [-],
+        selected_W1_over_sd [-], selected_KS [-].
     """
     out = []
     for r in rows:
-        d = {"channel": r["channel"], "rms_meas": r["rms_meas"], "rms_sim": r["rms_sim"],
-             "rms_err_pct": 100 * r["rms_err"], "mean_meas": r["mean_abs_meas"], "mean_sim": r["mean_abs_sim"],
-             "mean_err_pct": 100 * r["mean_abs_err"], "rmse_eq6_norm": r["rmse_eq6_norm"],
-             "W1_over_sd": r["wasserstein"], "KS": r["ks"]}
-        if spread and r["channel"] in spread:
-            sp = spread[r["channel"]]
-            d.update({"cand_median_err_pct": 100 * sp["median"], "cand_p16_pct": 100 * sp["p16"],
-                      "cand_p84_pct": 100 * sp["p84"], "cand_median_abs_pct": 100 * sp["median_abs"]})
+        c = r["channel"]
+        d = {"channel": c, "unit": _UNITS.get(c.rsplit("_", 1)[0], ""), "rms_meas": r["rms_meas"]}
+        sp = (spread or {}).get(c)
+        if sp:
+            d.update({"rms_sim_median": r["rms_meas"] * (1 + sp["median"]),
+                      "rms_err_median_pct": 100 * sp["median"], "rms_err_p16_pct": 100 * sp["p16"],
+                      "rms_err_p84_pct": 100 * sp["p84"], "rect_mean_meas": r["mean_abs_meas"]})
+            if "mean_abs_median" in sp:
+                d.update({"rect_mean_err_median_pct": 100 * sp["mean_abs_median"],
+                          "rect_mean_err_p16_pct": 100 * sp["mean_abs_p16"],
+                          "rect_mean_err_p84_pct": 100 * sp["mean_abs_p84"]})
+            d["n_realisations"] = int(sp.get("n", 0))
+        else:
+            d["rect_mean_meas"] = r["mean_abs_meas"]
+        d.update({"selected_rms_sim": r["rms_sim"], "selected_rms_err_pct": 100 * r["rms_err"],
+                  "selected_rect_mean_err_pct": 100 * r["mean_abs_err"],
+                  "selected_rmse_eq6_norm": r["rmse_eq6_norm"], "selected_W1_over_sd": r["wasserstein"],
+                  "selected_KS": r["ks"]})
         out.append(d)
     return pd.DataFrame(out)
 
 
-def write_table(df: pd.DataFrame, stem: Path, floatfmt: str = ".4g") -> list:
-    """Write ``stem.csv`` and ``stem.md``; returns the paths."""
+def write_table(df: pd.DataFrame, stem: Path, floatfmt: str = ".4g", note: str = "") -> list:
+    """Write ``stem.csv`` and ``stem.md`` (``note`` as a paragraph under the markdown
+    table); returns the paths."""
     stem = Path(stem)
     df.to_csv(stem.with_suffix(".csv"), index=False)
     cols = list(df.columns)
@@ -88,6 +122,8 @@ def write_table(df: pd.DataFrame, stem: Path, floatfmt: str = ".4g") -> list:
             v = r[c]
             cells.append(format(v, floatfmt) if isinstance(v, (float, np.floating)) else str(v))
         lines.append("| " + " | ".join(cells) + " |")
+    if note:
+        lines += ["", note]
     stem.with_suffix(".md").write_text("\n".join(lines) + "\n")
     return [stem.with_suffix(".csv"), stem.with_suffix(".md")]
 
