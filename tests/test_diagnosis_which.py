@@ -216,3 +216,42 @@ def test_shape_term_skewness_and_its_noise():
     z0 = np.array([term.z([window() for _ in range(4)], "held") for _ in range(40)])
     assert 0.6 < z0.std() < 1.6
     assert abs(term.z([window(True) for _ in range(4)], "held")) > 5
+
+
+#: the toy library plus a speed-signal scale (identified through the delay term): five
+#: candidates, so the verdict is a choice among many, not between two
+FIVE = list(toy.TOY_CANDIDATES) + [Candidate("speed_scale", (Param("scale", 0.85, 1.15),))]
+
+
+@pytest.mark.parametrize("truth, want, param, value", [
+    ({"damper": {"scale": 0.6}}, "damper", "scale", 0.6),
+    ({"payload": {"mass_scale": 1.3}}, "payload", "mass_scale", 1.3),
+    ({}, "none", None, None),
+], ids=["damper", "payload", "null"])
+def test_verdict_among_five_candidates(truth, want, param, value):
+    """Verdict among five candidates (tyre stiffness, payload, damper, sensor low-pass,
+    speed scale with the front-to-rear delay term) where the answer is known by construction:
+    the measurement is the toy with exactly one effect (damper x0.6 or sprung mass x1.3,
+    truths the other ranking tests do not use) or with none.  Required: that effect, "clear"
+    (payload and damper both change the body mode and each is accepted as a rival when the
+    other is the truth, so "clear" means the right one is clearly better), the calibrated
+    parameter within 10 % (the search ranges span 0.5-2 and 0.7-1.5; measured errors 4 % and
+    3 %), every held-out seed's gap shrunk; for the null measurement "none" with no entry
+    accepted.  Same budget as the other toy rankings (80 s measured, 4 held-out seeds,
+    8 surrogates, grid 4 + golden 5, no pairs); about 10 s per case."""
+    from diagnosis.which import DelayTerm
+
+    calib, held = _windows(truth, 21)
+    r = rank_effects(FIVE, toy.fit, toy.simulate, calib, held, seed=9, n_seeds=4, n_null=8,
+                     grid=4, refine=5, pairs=False,
+                     delay=DelayTerm([("axle_acc_1L", "axle_acc_3L")], [4.0]))
+    assert len(r.entries) == 5
+    assert r.verdict == want
+    if want == "none":
+        assert r.confidence == "none"
+        assert not any(e.accepted for e in r.entries)
+        return
+    assert r.confidence == "clear"
+    w = r.winner
+    assert w.accepted and np.all(w.shrink_per_seed > 0)
+    assert w.effects[want][param] == pytest.approx(value, rel=0.10)
