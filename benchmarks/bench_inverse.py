@@ -80,6 +80,9 @@ def score_case(truth: dict, summary: dict) -> dict:
                      # signed errors and what the fit reported, for the interval calibration
                      "lnGq_err": math.log(f["Gq_n0"] / s["Gq_n0"]), "w_err": f["w"] - s["w"],
                      "sd_ln_Gq_n0": f["sd"]["ln_Gq_n0"], "sd_w": f["sd"]["w"],
+                     "sd_laplace": f.get("sd_laplace", f["sd"]),
+                     "sd_ln_G_n_best_laplace": f.get("sd_ln_G_n_best_laplace", f.get("sd_ln_G_n_best")),
+                     "fit_quality": f.get("fit_quality"),
                      "objective": f.get("objective"), "n_features": f.get("n_features"),
                      "fit_duration_s": f["t_end"] - f["t_start"],
                      **({"interval": f["interval"]} if "interval" in f else {}),

@@ -86,6 +86,11 @@ def _cmd_invert(args) -> int:
               + ", ".join(err(c) for c in ("axle_acc_3L", "axle_acc_3R") if c in e)
               + " (median [16-84 %] over road realisations)"
               + f" ({summary['timing']['total_s']:.1f} s wall)")
+        for w in summary["dataset"].get("warnings", []):
+            print(f"warning: {args.dataset}/{w}")
+        fq = summary.get("fit_quality", {})
+        if fq.get("status") == "poor":
+            print(f"POOR FIT: {fq['message']}")
     return 0
 
 
@@ -205,7 +210,9 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     from drives.format import read_drive
     from inverse.pipeline import SEED_KEY_FIT, InversionConfig, invert, stream_seed
     from inverse.realisation import candidate_seeds, select_realisation
-    from inverse.report import TABLE2_CHANNELS, TABLE2_NOTE, table1, table2, write_figures, write_table
+    from inverse.report import (TABLE2_CHANNELS, TABLE2_NOTE, table1, table1_note, table2, write_figures,
+                                write_table)
+    from inverse.uncertainty import overall_fit_quality
     from inverse.sensitivity import FitConfig
     from inverse.spectral import ParamBounds
     from inverse.truck import SIM_DX, TruckPredictRms, make_truck_simulator, nmax_cap
@@ -282,8 +289,10 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         summary = {
             "format": RUN_FORMAT,
             "dataset": {"name": drive.name, "path": str(Path(dataset).resolve()), "vehicle": str(drive.vehicle),
-                        "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz},
+                        "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz,
+                        "warnings": list(drive.warnings)},
             "segments": segs,
+            "fit_quality": overall_fit_quality(segs),
             "table2": rows,
             "errors": _headline(rows, sel["spread"]),
             "selection": {"n_candidates": len(seeds), "selected": sel["label"], "seed": sel["seed"],
@@ -299,7 +308,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             "road": {"file": "road.npz", "crg": "road.crg", "seed": sel["seed"], "dx": SIM_DX,
                      "seg_lengths_m": [float(v) for v in sim.layout()["seg_lengths"]]},
         }
-        write_table(table1(segs), tmp / "tables" / "table1")
+        write_table(table1(segs), tmp / "tables" / "table1", note=table1_note(summary["fit_quality"]))
         write_table(table2(rows, sel["spread"]), tmp / "tables" / "table2", note=TABLE2_NOTE)
         import pandas as pd
         pd.DataFrame([{"label": c["label"], "seed": c["seed"], "mismatch": c["mismatch"],

@@ -107,23 +107,41 @@ class Inversion:
         -------
         list of dict
             t_start, t_end [s], proportion [-], Gq_n0 [m^3], w [-], nmin, nmax
-            [cycles/m], dx, dy [m], class, initial_class, identifiable, sd,
-            objective, n_features, converged, and where the level is best
-            determined: n_best [cycles/m], G_n_best [m^3], sd_ln_G_n_best [-]
-            (:func:`inverse.sensitivity.best_level`).
+            [cycles/m], dx, dy [m], class, initial_class, identifiable, objective,
+            n_features, converged, and where the level is best determined: n_best
+            [cycles/m], G_n_best [m^3] (:func:`inverse.sensitivity.best_level`).
+            Uncertainty (:mod:`inverse.uncertainty`): ``sd`` per theta component,
+            ``sd_ln_Gq_n0`` and ``sd_ln_G_n_best`` are the REPORTED standard deviations
+            (noise, realisation and model-form error, calibrated on blind drives);
+            ``sd_laplace`` and ``sd_ln_G_n_best_laplace`` the fit's noise-only ones;
+            ``interval90`` the 90 % intervals of Gq_n0, w and G_n_best; ``fit_quality``
+            the gate (status 'clean' or 'poor', misfit per feature).
         """
+        from inverse.uncertainty import fit_quality, honest_sd, interval90
+
         rows = []
         tb = self.t_bounds
         prop = self.segmentation.proportions
         for k, s in enumerate(self.fit.segments):
             d = s.as_dict()
+            sd = honest_sd(d["sd"], d.get("sd_ln_G_n_best"), d["objective"], d["n_features"])
+            iv = {"Gq_n0": interval90(d["Gq_n0"], sd["ln_Gq_n0"], log=True),
+                  "w": interval90(d["w"], sd["w"], log=False)}
+            best = {}
+            if "n_best" in d:
+                best = {"n_best": d["n_best"], "G_n_best": d["G_n_best"], "sd_ln_G_n_best": sd["ln_G_n_best"],
+                        "sd_ln_G_n_best_laplace": d["sd_ln_G_n_best"]}
+                iv["G_n_best"] = interval90(d["G_n_best"], sd["ln_G_n_best"], log=True)
             rows.append({"t_start": float(tb[k]), "t_end": float(tb[k + 1]), "proportion": float(prop[k]),
                          "Gq_n0": d["Gq_n0"], "w": d["w"], "nmin": d["nmin"], "nmax": d["nmax"],
                          "dx": d["dx"], "dy": d["dy"], "class": d["class"],
                          "initial_class": self.segmentation.classes[k],
-                         "identifiable": d["identifiable"], "sd": d["sd"], "objective": d["objective"],
-                         "n_features": d["n_features"], "converged": d["converged"],
-                         **{key: d[key] for key in ("n_best", "G_n_best", "sd_ln_G_n_best") if key in d}})
+                         "identifiable": d["identifiable"],
+                         "sd": {key: v for key, v in sd.items() if key != "ln_G_n_best"},
+                         "sd_laplace": d["sd"], "sd_ln_Gq_n0": sd["ln_Gq_n0"], "interval90": iv,
+                         "fit_quality": fit_quality(d["objective"], d["n_features"]),
+                         "objective": d["objective"], "n_features": d["n_features"], "converged": d["converged"],
+                         **best})
         return rows
 
     def summary(self) -> dict:

@@ -30,7 +30,9 @@ def table1(segments: list) -> pd.DataFrame:
         segment, t_start, t_end [s], proportion [%], class, Gq_n0 [1e-6 m^3], w,
         nmin, nmax [cycles/m], dx, dy [m], not identifiable (names), and where
         present the best-determined level (n_best [cycles/m], G_n_best
-        [1e-6 m^3], sd of ln G there) with the sd of ln Gq_n0 for comparison.
+        [1e-6 m^3], sd of ln G there) with the sd of ln Gq_n0 for comparison, the
+        90 % intervals of Gq_n0 and w, and the fit-quality gate ('clean' / 'poor')
+        with the misfit per feature (:mod:`inverse.uncertainty`).
     """
     rows = []
     for i, s in enumerate(segments):
@@ -43,8 +45,26 @@ def table1(segments: list) -> pd.DataFrame:
                      "dx_m": s["dx"], "dy_m": s["dy"], "not_identifiable": " ".join(held),
                      **({"n_best_cpm": round(s["n_best"], 3), "G_n_best_1e-6m3": round(1e6 * s["G_n_best"], 4),
                          "sd_ln_G_n_best": round(s["sd_ln_G_n_best"], 3), "sd_ln_Gq_n0": round(s["sd"]["ln_Gq_n0"], 3)}
-                        if "n_best" in s else {})})
+                        if "n_best" in s else {}),
+                     **({"Gq_n0_90pct_1e-6m3": "{:.3g}-{:.3g}".format(*(1e6 * v for v in s["interval90"]["Gq_n0"])),
+                         "w_90pct": "{:.2f}-{:.2f}".format(*s["interval90"]["w"])} if "interval90" in s else {}),
+                     **({"fit": s["fit_quality"]["status"],
+                         "misfit_per_feature": round(s["fit_quality"]["misfit_per_feature"], 2)}
+                        if "fit_quality" in s else {})})
     return pd.DataFrame(rows)
+
+
+def table1_note(fit_quality: dict | None = None) -> str:
+    """The paragraph under Table 1: what the uncertainty columns mean, and the gate's verdict."""
+    from inverse.uncertainty import R_GATE
+
+    note = ("The 90 % intervals and sd columns hold noise, realisation and model-form error, "
+            "calibrated on blind drives (docs/inverse.md, section 11). 'fit' is the fit-quality gate: "
+            f"'poor' where the misfit per feature exceeds {R_GATE:g}, i.e. the model does not explain "
+            "the segment's data and its numbers are not a clean result.")
+    if fit_quality and fit_quality.get("status") == "poor":
+        note = f"**POOR FIT**: {fit_quality['message']}.\n\n" + note
+    return note
 
 
 #: unit of each Table 2 quantity by channel prefix

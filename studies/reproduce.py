@@ -163,11 +163,16 @@ def _manifest(run: Path) -> list:
     return rows
 
 
-def _manifest_md(rows: list, timings: dict) -> str:
+def _manifest_md(rows: list, timings: dict, fit_quality: dict | None = None) -> str:
     lines = ["# eroad reproduce: manifest", "",
              "Each paper item, the file(s) that show it (relative to this folder) and the "
-             "code that made them.", "",
-             "| paper item | file(s) | code |", "|---|---|---|"]
+             "code that made them.", ""]
+    if fit_quality and fit_quality.get("status") == "poor":
+        lines += [f"**Inversion: POOR FIT.** {fit_quality['message']}. Tables 1-2 and the road are "
+                  "shown, but they are not a clean result.", ""]
+    elif fit_quality:
+        lines += ["Inversion: every segment passes the fit-quality gate.", ""]
+    lines += ["| paper item | file(s) | code |", "|---|---|---|"]
     for r in rows:
         files = "<br>".join(f"[{f}]({f})" for f in r["files"]) or "**missing**"
         lines.append(f"| {r['item']} | {files} | `{r['code']}` |")
@@ -242,7 +247,8 @@ def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False
                    "wall_s": record["wall_s"], "manifest": rows, "steps": results}
         write_json_atomic(tmp / "summary.json", _jsonable(summary))
         write_json_atomic(tmp / "manifest.json", rows)
-        (tmp / "manifest.md").write_text(_manifest_md(rows, timings))
+        fq = results.get("invert", {}).get("fit_quality") if isinstance(results.get("invert"), dict) else None
+        (tmp / "manifest.md").write_text(_manifest_md(rows, timings, fq))
         target = out if record["status"] == "complete" else out.with_name(f"{out.name}.failed-{os.getpid()}")
         if target.exists():
             target.rmdir()  # empty (checked above)

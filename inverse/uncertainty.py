@@ -1,0 +1,124 @@
+"""Honest per-segment uncertainty of the spectral fit, and the fit-quality gate.
+
+What this module is for: the fit's Laplace standard deviations (``SegmentFit.sd``) hold
+the measurement noise of the features only. The error of a fitted segment against the
+road it came from also carries
+
+* the realisation scatter: the simulated features are one road realisation (common
+  random numbers) and the measured ones another;
+* the model-form error: a vehicle that differs from the model (friction, a flexible
+  frame, anything no library lists) moves the fit by an amount the noise does not
+  describe.
+
+Both show in the residual: a fit whose weighted misfit per feature ``r = objective /
+n_features`` is well above what a correct model reaches is not explained by noise. So
+the reported standard deviation is the Laplace one scaled up (Birge's ratio, as in
+least-squares metrology when the residual exceeds its expectation) and given a floor:
+
+    sd = KAPPA[param] * sd_laplace * sqrt(max(1, r / R_REF)),   and at least SD_FLOOR[param]
+
+``R_REF`` is the median misfit per feature of correctly modelled drives and ``kappa``
+the factor that makes the 90 % intervals cover the truth in 90 % of segments of those
+drives; both were calibrated on blind drives (``benchmarks/bench_inverse.py``, results
+and the command in ``results/inverse_blind/``; docs/inverse.md, section 11). The
+coverage is then CHECKED on drives with a model gap, not tuned on them.
+
+The gate: a segment whose ``r`` exceeds ``R_GATE`` (the 95th percentile of ``r`` on
+the correctly modelled drives, so about 1 in 20 clean segments is flagged by chance) is
+reported ``poor``: the model does not explain these data, its numbers are not a clean
+result, run the diagnosis.
+
+What it is not: a bias correction. A wider interval is the honest answer to a misfit;
+removing the misfit takes the missing effect in the model (``eroad diagnose``,
+``eroad invert --effect``).
+"""
+from __future__ import annotations
+
+import math
+
+#: median misfit per feature (objective / n_features) on correctly modelled blind drives
+R_REF = 0.6
+#: misfit per feature above which a segment fit is flagged ``poor``
+R_GATE = 1.5
+#: scale of the Laplace sd per quantity that makes 90 % intervals hold on correctly
+#: modelled drives (ln_nmin, ln_nmax: not calibrated, the ln_Gq_n0 factor is used)
+KAPPA = {"ln_Gq_n0": 1.0, "w": 1.0, "ln_G_n_best": 1.0}
+#: floors of the reported sd [ln units for levels, - for w]
+SD_FLOOR = {"ln_Gq_n0": 0.0, "w": 0.0, "ln_G_n_best": 0.0}
+#: two-sided 90 % normal quantile
+Z90 = 1.6448536269514722
+
+#: the gate's message, as the CLI, Table 1 and the manifest print it
+POOR_FIT_MESSAGE = "the model does not explain these data (misfit {r:.2f} per feature > {gate:g}): run the diagnosis"
+
+
+def inflation(objective: float, n_features: int, param: str = "ln_Gq_n0") -> float:
+    """The factor on the Laplace sd of ``param``: ``KAPPA[param] * sqrt(max(1, r / R_REF))`` [-]."""
+    r = objective / max(int(n_features), 1)
+    return KAPPA.get(param, KAPPA["ln_Gq_n0"]) * math.sqrt(max(1.0, r / R_REF))
+
+
+def fit_quality(objective: float, n_features: int) -> dict:
+    """The gate of one segment fit.
+
+    Returns
+    -------
+    dict
+        ``misfit_per_feature`` [-], ``gate`` [-], ``status`` ('clean' or 'poor'),
+        ``message`` (empty when clean).
+    """
+    r = objective / max(int(n_features), 1)
+    poor = r > R_GATE
+    return {"misfit_per_feature": r, "gate": R_GATE, "status": "poor" if poor else "clean",
+            "message": POOR_FIT_MESSAGE.format(r=r, gate=R_GATE) if poor else ""}
+
+
+def honest_sd(sd_laplace: dict, sd_ln_G_n_best: float | None, objective: float, n_features: int) -> dict:
+    """Reported standard deviations of one segment.
+
+    Parameters
+    ----------
+    sd_laplace : dict
+        The fit's Laplace sd per theta component (``ln_Gq_n0``, ``w``, ``ln_nmin``, ``ln_nmax``).
+    sd_ln_G_n_best : float or None
+        Laplace sd of ln Gd at n_best.
+    objective, n_features : float, int
+        The segment's weighted misfit and its number of features.
+
+    Returns
+    -------
+    dict
+        Same keys as ``sd_laplace`` (scaled) plus ``ln_G_n_best`` when given [ln units or -].
+    """
+    out = {k: max(inflation(objective, n_features, k) * v, SD_FLOOR.get(k, 0.0)) for k, v in sd_laplace.items()}
+    if sd_ln_G_n_best is not None:
+        out["ln_G_n_best"] = max(inflation(objective, n_features, "ln_G_n_best") * sd_ln_G_n_best,
+                                 SD_FLOOR["ln_G_n_best"])
+    return out
+
+
+def interval90(value: float, sd: float, log: bool) -> list:
+    """The 90 % interval [lo, hi] of a parameter whose sd is ``sd`` (in ln units if ``log``)."""
+    if log:
+        return [value * math.exp(-Z90 * sd), value * math.exp(Z90 * sd)]
+    return [value - Z90 * sd, value + Z90 * sd]
+
+
+def overall_fit_quality(segments: list) -> dict:
+    """The run's gate from its segment rows: 'poor' when any segment is.
+
+    Returns
+    -------
+    dict
+        ``status``, ``poor_segments`` (1-based, as Table 1 numbers them, with their
+        absolute times), ``message`` (one line; empty when clean).
+    """
+    poor = [(i + 1, s) for i, s in enumerate(segments) if s.get("fit_quality", {}).get("status") == "poor"]
+    if not poor:
+        return {"status": "clean", "poor_segments": [], "message": ""}
+    where = ", ".join(f"{i} ({s['t_start']:.1f}-{s['t_end']:.1f} s, misfit "
+                      f"{s['fit_quality']['misfit_per_feature']:.2f})" for i, s in poor)
+    return {"status": "poor", "poor_segments": [i for i, _ in poor],
+            "message": f"segment(s) {where} exceed the fit-quality gate {R_GATE:g}: the model does not "
+                       f"explain these data; their parameters are not a clean result: run the diagnosis "
+                       f"(eroad diagnose) and invert with the effect it names"}

@@ -1,0 +1,63 @@
+"""Reported uncertainty and the fit-quality gate (inverse.uncertainty) and where they show."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from inverse import uncertainty as U
+from inverse.report import table1, table1_note
+
+
+def test_inflation_is_birge_ratio_above_the_reference_misfit():
+    """At or below the reference misfit the Laplace sd is scaled by KAPPA only; above it by
+    KAPPA sqrt(r / R_REF) (Birge's ratio): 4x the reference misfit doubles the sd."""
+    nf = 100
+    k = U.KAPPA["ln_Gq_n0"]
+    assert U.inflation(0.5 * U.R_REF * nf, nf) == pytest.approx(k)
+    assert U.inflation(U.R_REF * nf, nf) == pytest.approx(k)
+    assert U.inflation(4 * U.R_REF * nf, nf) == pytest.approx(2 * k)
+    assert U.inflation(4 * U.R_REF * nf, nf, "w") == pytest.approx(2 * U.KAPPA["w"])
+
+
+def test_interval90_holds_90_percent_of_normal_draws():
+    """The interval is +-1.645 sd: of 200000 normal draws 90.0 % fall inside (binomial sd
+    0.07 %, so 0.3 % is over 4 sd)."""
+    rng = np.random.default_rng(0)
+    x = rng.standard_normal(200_000)
+    lo, hi = U.interval90(0.0, 1.0, log=False)
+    assert np.mean((x > lo) & (x < hi)) == pytest.approx(0.90, abs=0.003)
+    lo, hi = U.interval90(2.0, 0.5, log=True)
+    assert math.log(hi / 2.0) == pytest.approx(U.Z90 * 0.5) and math.log(2.0 / lo) == pytest.approx(U.Z90 * 0.5)
+
+
+def test_gate_flags_misfit_above_the_gate_and_names_segments_with_times():
+    segs = [{"t_start": 460.0, "t_end": 472.5, "fit_quality": U.fit_quality(U.R_GATE * 2 * 50, 50)},
+            {"t_start": 472.5, "t_end": 490.0, "fit_quality": U.fit_quality(U.R_REF * 50, 50)}]
+    assert segs[0]["fit_quality"]["status"] == "poor" and segs[1]["fit_quality"]["status"] == "clean"
+    assert "run the diagnosis" in segs[0]["fit_quality"]["message"]
+    o = U.overall_fit_quality(segs)
+    assert o["status"] == "poor" and o["poor_segments"] == [1] and "460.0-472.5 s" in o["message"]
+    assert U.overall_fit_quality(segs[1:])["status"] == "clean"
+    note = table1_note(o)
+    assert note.startswith("**POOR FIT**") and "460.0-472.5 s" in note
+
+
+def test_honest_sd_scales_every_component_and_keeps_floors():
+    lap = {"ln_Gq_n0": 0.1, "w": 0.05, "ln_nmin": 0.3, "ln_nmax": 0.2}
+    sd = U.honest_sd(lap, 0.04, objective=4 * U.R_REF * 10, n_features=10)
+    for k, v in lap.items():
+        f = 2 * U.KAPPA.get(k, U.KAPPA["ln_Gq_n0"])
+        assert sd[k] == pytest.approx(max(f * v, U.SD_FLOOR.get(k, 0.0)))
+    assert sd["ln_G_n_best"] == pytest.approx(max(2 * U.KAPPA["ln_G_n_best"] * 0.04, U.SD_FLOOR["ln_G_n_best"]))
+
+
+def test_table1_shows_intervals_and_gate():
+    seg = {"t_start": 0.0, "t_end": 10.0, "proportion": 1.0, "class": "C", "Gq_n0": 256e-6, "w": 2.0,
+           "nmin": 0.05, "nmax": 5.0, "dx": 0.1, "dy": 0.1, "identifiable": {}, "sd": {"ln_Gq_n0": 0.2},
+           "interval90": {"Gq_n0": [200e-6, 330e-6], "w": [1.8, 2.2]},
+           "fit_quality": U.fit_quality(0.5, 1)}
+    row = table1([seg]).iloc[0]
+    assert row["Gq_n0_90pct_1e-6m3"] == "200-330" and row["w_90pct"] == "1.80-2.20"
+    assert row["fit"] == "clean" and row["misfit_per_feature"] == 0.5
