@@ -1,15 +1,77 @@
-"""``eroad reproduce``: the main command, end to end in its quick mode.
+"""``eroad reproduce``: the main command, end to end.
 
-The quick run is the CI smoke test of the whole chain (dataset -> Figures 4-5 ->
-inversion -> Figure 11 -> chassis study -> diagnosis); it checks that every paper
-item of the manifest is produced, not the science (each package's own tests do
-that).
+The full quick run (dataset -> Figures 4-5 -> inversion -> Figure 11 -> chassis study ->
+diagnosis) takes 2-4 minutes, so it is a ``slow`` test; it checks that every paper
+item is on disk as a valid file (not only that the manifest says so), not the science
+(each package's own tests do that).  The default run checks a partial run of the first
+two steps (about 5 s): the same on-disk validation for Figures 4-5, and that the
+manifest reports every item of the steps not run as missing.
 """
 import json
+from pathlib import Path
 
+import numpy as np
 import pytest
 
 from eroad.cli import main
+
+#: paper item -> (file pattern relative to the run folder, kind of file); written out from
+#: the paper's list (studies/reproduce.py module docstring, docs/studies.md) rather than
+#: taken from studies.reproduce.MANIFEST, so that a manifest that drops or renames an
+#: item fails here
+PAPER_ITEMS = {
+    "Figure 4": ("fig4_5/figure4_displacement.png", "png"),
+    "Figure 5": ("fig4_5/figure5_spectrum.png", "png"),
+    "Figure 6": ("invert/figures/figure6_segmentation.png", "png"),
+    "Table 1": ("invert/tables/table1.md", "md"),
+    "Figure 8": ("invert/figures/figure8_time_compare.png", "png"),
+    "Figure 9": ("invert/figures/figure9_amplitude_distributions.png", "png"),
+    "Table 2": ("invert/tables/table2.md", "md"),
+    "Global road (section 2.5)": ("invert/road.npz", "road"),
+    "Figure 11": ("figure11/figures/figure11.png", "png"),
+    "Findings of section 5 (true/false)": ("figure11/data/findings.md", "md"),
+    "Chassis-stiffness study": ("chassis/figures/*.png", "png"),
+    "Sim-to-real gap diagnosis": ("diagnose/report.md", "md"),
+}
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def check_file(path: Path, kind: str) -> None:
+    """Assert that ``path`` is a non-empty, readable file of its kind.
+
+    png: PNG signature, decodes to an image of at least 200 x 200 pixels that is not one
+    flat colour (a figure with nothing drawn); md: UTF-8 text with a heading or a
+    markdown table holding at least one data row; road: a road surface that loads, with
+    finite heights that are not all equal, on an increasing x grid."""
+    assert path.is_file(), path
+    data = path.read_bytes()
+    assert len(data) > 0, path
+    if kind == "png":
+        import matplotlib.image as mpimg
+
+        assert data[:8] == PNG_MAGIC, path
+        img = mpimg.imread(path)
+        assert img.ndim == 3 and img.shape[0] >= 200 and img.shape[1] >= 200, (path, img.shape)
+        assert float(np.std(img[..., :3])) > 0.01, f"{path}: a blank image"
+    elif kind == "md":
+        text = data.decode("utf-8")
+        lines = [ln for ln in text.splitlines() if ln.strip()]
+        sep = [i for i, ln in enumerate(lines) if ln.startswith("|") and set(ln.replace("|", "").strip()) <= set("-: ")]
+        assert text.lstrip().startswith("#") or sep, f"{path}: neither a heading nor a table"
+        for i in sep:   # every table has a data row under its separator
+            assert i + 1 < len(lines) and lines[i + 1].startswith("|"), f"{path}: empty table"
+    elif kind == "road":
+        from roadlib.surface import RoadSurface
+
+        road = RoadSurface.load(path)
+        assert np.all(np.isfinite(road.z)) and np.ptp(road.z) > 0, path
+        assert np.all(np.diff(road.x) > 0) and road.length > 0, path
+    else:  # pragma: no cover - a typo in PAPER_ITEMS
+        raise ValueError(kind)
+
+
+def files_on_disk(run: Path, pattern: str) -> list[str]:
+    return sorted(str(p.relative_to(run)) for p in run.glob(pattern))
 
 
 def test_unknown_step_refused(tmp_path, capsys):
@@ -28,26 +90,60 @@ def test_existing_output_is_not_touched(tmp_path, capsys):
     assert (out / "precious.txt").read_text() == "keep me"
 
 
+@pytest.fixture(scope="module")
+def partial_run(tmp_path_factory):
+    """``eroad reproduce --steps dataset,fig4_5`` (about 5 s)."""
+    out = tmp_path_factory.mktemp("reproduce") / "run"
+    assert main(["reproduce", "--out", str(out), "--steps", "dataset,fig4_5", "--json"]) == 0
+    return out
+
+
+def test_partial_reproduce_files_and_manifest(partial_run):
+    """The steps run produce Figures 4-5 as valid PNGs on disk; the manifest lists exactly
+    those files for them, marks them present, and marks every item of the steps not run
+    missing, with no file on disk (the manifest neither drops nor invents an item)."""
+    out = partial_run
+    manifest = {row["item"]: row for row in json.loads((out / "manifest.json").read_text())}
+    assert set(manifest) == set(PAPER_ITEMS)
+    for item, (pattern, kind) in PAPER_ITEMS.items():
+        on_disk = files_on_disk(out, pattern)
+        assert manifest[item]["files"] == on_disk, item
+        if item in ("Figure 4", "Figure 5"):
+            assert len(on_disk) == 1 and manifest[item]["present"] is True, item
+            check_file(out / on_disk[0], kind)
+        else:
+            assert on_disk == [] and manifest[item]["present"] is False, item
+    md = (out / "manifest.md").read_text()
+    assert md.count("**missing**") == len(PAPER_ITEMS) - 2
+    assert json.loads((out / "run.json").read_text())["status"] == "complete"
+
+
+def test_recorded_paths_point_into_the_final_folder(partial_run):
+    """Steps record the dataset path they were given; after the temporary run folder is
+    renamed into place, those records must name the final folder, not the vanished one."""
+    out = partial_run
+    texts = [p.read_text() for p in out.rglob("*.json")]
+    assert not any(".run.tmp-" in t for t in texts)
+    assert any(str(out.resolve()) in t for t in texts)
+
+
+@pytest.mark.slow
 def test_quick_reproduce_produces_every_paper_item(tmp_path):
+    """Every paper item is on disk after the quick run, as a valid file of its kind
+    (:func:`check_file`), independently of the manifest's ``present`` flag; and the
+    manifest agrees with the disk."""
     out = tmp_path / "run"
     assert main(["reproduce", "--quick", "--out", str(out), "--json"]) == 0
-    manifest = json.loads((out / "manifest.json").read_text())
-    missing = [row["item"] for row in manifest if not row["present"]]
-    assert missing == []
-    for row in manifest:
-        for f in row["files"]:
-            assert (out / f).stat().st_size > 0, f
+    manifest = {row["item"]: row for row in json.loads((out / "manifest.json").read_text())}
+    assert set(manifest) == set(PAPER_ITEMS)
+    for item, (pattern, kind) in PAPER_ITEMS.items():
+        on_disk = files_on_disk(out, pattern)
+        assert on_disk, f"{item}: no {pattern} in the run"
+        for f in on_disk:
+            check_file(out / f, kind)
+        assert manifest[item]["files"] == on_disk and manifest[item]["present"] is True, item
+    assert "**missing**" not in (out / "manifest.md").read_text()
     run = json.loads((out / "run.json").read_text())
     assert run["status"] == "complete"
     # nothing of the synthetic truth is copied into the run
     assert not (out / "dataset" / "truth").exists()
-
-
-def test_recorded_paths_point_into_the_final_folder(tmp_path):
-    """Steps record the dataset path they were given; after the temporary run folder is
-    renamed into place, those records must name the final folder, not the vanished one."""
-    out = tmp_path / "run"
-    assert main(["reproduce", "--out", str(out), "--steps", "dataset,fig4_5", "--json"]) == 0
-    texts = [p.read_text() for p in out.rglob("*.json")]
-    assert not any(".run.tmp-" in t for t in texts)
-    assert any(str(out.resolve()) in t for t in texts)
