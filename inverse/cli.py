@@ -56,6 +56,11 @@ def register(subparsers) -> None:
                         "channel), or a comma list")
     p.add_argument("--effect", action="append", default=[], metavar="NAME[.PARAM]=VALUE",
                    help="effect added to the nominal model (repeatable), e.g. leaf_friction")
+    p.add_argument("--effects", choices=("auto",), default=None,
+                   help="auto: run the gap diagnosis first (RUN/diagnose) and, if it names an effect "
+                        "with confidence 'clear', invert with it at its calibrated value; the nominal "
+                        "inversion goes to RUN/nominal and Table 1 side by side to "
+                        "RUN/tables/table1_nominal_vs_corrected.md (about 3-4x the time)")
     p.add_argument("--noise", action="append", default=[], metavar="NAME=SD",
                    help="known white sensor noise, standard deviation in the channel's SI unit, for a "
                         "channel (susp_disp_3L=1e-4) or a quantity (axle_acc=0.03); repeatable; channels "
@@ -67,10 +72,18 @@ def register(subparsers) -> None:
 
 
 def _cmd_invert(args) -> int:
-    summary = run_inversion(args.dataset, args.out, segments=args.segments, workers=args.workers,
-                            seed=args.seed, quick=args.quick, force=args.force, candidates=args.candidates,
-                            max_iter=args.max_iter, channels=args.channels, effects=_effects(args.effect),
-                            noise_sd=_noise(args.noise), argv=sys.argv)
+    common = dict(segments=args.segments, workers=args.workers, seed=args.seed, quick=args.quick,
+                  force=args.force, candidates=args.candidates, max_iter=args.max_iter,
+                  channels=args.channels, noise_sd=_noise(args.noise), argv=sys.argv)
+    if args.effects == "auto":
+        if args.effect:
+            raise EroadInputError("--effects auto and --effect NAME=VALUE cannot be combined")
+        # the one place the inverse CLI reaches the diagnosis layer: the closed loop sits above both
+        from diagnosis.closed_loop import invert_closed_loop
+        summary = invert_closed_loop(args.dataset, args.out,
+                                     progress=(lambda m: print(m, file=sys.stderr, flush=True)), **common)
+    else:
+        summary = run_inversion(args.dataset, args.out, effects=_effects(args.effect), **common)
     if args.json:
         print(json.dumps(summary, indent=2))
     else:
@@ -91,6 +104,8 @@ def _cmd_invert(args) -> int:
         fq = summary.get("fit_quality", {})
         if fq.get("status") == "poor":
             print(f"POOR FIT: {fq['message']}")
+        if "closed_loop" in summary:
+            print(f"closed loop: {summary['closed_loop']['reason']}")
     return 0
 
 

@@ -1,0 +1,150 @@
+"""The loop closed: diagnose a drive, then invert it with the effect the diagnosis names.
+
+What this module is for: ``eroad invert DATASET --effects auto`` and ``eroad reproduce``.
+An inversion with the nominal model on a drive whose vehicle differs from it puts the
+difference into the road (the leaf-friction gap of the embedded dataset moved its levels
+by a factor 0.3-1.4); the diagnosis finds the difference but, until now, nothing used it.
+Here the diagnosis runs first (nominal model, its own cheap road fit), and where it names
+an effect with confidence ``clear`` the drive is inverted twice, with the nominal model
+and with the named effect at its calibrated value, side by side; the corrected inversion
+is the run's result (its road goes on to Figure 11 and the chassis study). Where the
+verdict is ``none``, ``unexplained``, or not ``clear``, the nominal inversion is the result
+and the report says why no correction was made: a correction the data do not single out
+would replace one model error by another.
+
+What it is not: a diagnosis or an inversion of its own; it calls
+:func:`diagnosis.pipeline.diagnose` and :func:`inverse.cli.run_inversion`, and writes::
+
+    RUN/                 the chosen inversion's run folder (summary.json, tables, figures, road)
+    RUN/diagnose/        the diagnosis (report.md, summary.json, figures)
+    RUN/nominal/         the nominal inversion, where a corrected one was made
+    RUN/tables/table1_nominal_vs_corrected.{csv,md}
+    summary.json         gains ``closed_loop``: verdict, confidence, effects used, reason,
+                         and the nominal segments beside the corrected ones
+"""
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pandas as pd
+
+from eroad.errors import EroadInputError
+
+
+def effects_from_diagnosis(summary: dict) -> tuple[dict | None, str]:
+    """The effects to invert with, from a diagnosis summary, and why.
+
+    Parameters
+    ----------
+    summary : dict
+        ``diagnose``'s summary.json.
+
+    Returns
+    -------
+    effects : dict or None
+        ``{effect: {parameter: value}}`` (the calibrated candidate's parameters) when the
+        verdict is an effect with confidence ``clear``; None otherwise.
+    reason : str
+        One line for the report.
+    """
+    verdict = summary.get("verdict", "none")
+    conf = summary.get("verdict_confidence", "none")
+    if verdict in ("none", "unexplained", None):
+        return None, f"the diagnosis answered '{verdict}': the nominal model is kept"
+    if conf != "clear":
+        return None, (f"the diagnosis named {verdict} with confidence '{conf}' only: the nominal model "
+                      f"is kept (a correction is made on 'clear' verdicts)")
+    entry = next((r for r in summary.get("ranking", []) if r.get("effect") == verdict), None)
+    if entry is None or not entry.get("parameters"):
+        return None, f"the diagnosis named {verdict} but recorded no calibrated parameters: nominal model kept"
+    params = {str(k): {str(p): float(v) for p, v in d.items()} for k, d in entry["parameters"].items()}
+    text = ", ".join(f"{k}." + ", ".join(f"{p}={v:.4g}" for p, v in d.items()) for k, d in params.items())
+    return params, f"the diagnosis named {verdict} (confidence clear); inverted with {text}"
+
+
+def compare_table(nominal: list, corrected: list) -> pd.DataFrame:
+    """Table 1 nominal beside corrected: per segment of each fit, class, Gq(n0), w, 90 % interval
+    of Gq(n0) and the fit-quality gate (the two segmentations may differ; rows are by fit)."""
+    rows = []
+    for label, segs in (("nominal", nominal), ("corrected", corrected)):
+        for i, s in enumerate(segs):
+            iv = s.get("interval90", {}).get("Gq_n0")
+            rows.append({"model": label, "segment": i + 1, "t_start_s": round(s["t_start"], 2),
+                         "t_end_s": round(s["t_end"], 2), "class": s["class"],
+                         "Gq_n0_1e-6m3": round(1e6 * s["Gq_n0"], 2), "w": round(s["w"], 3),
+                         "Gq_n0_90pct_1e-6m3": "{:.3g}-{:.3g}".format(*(1e6 * v for v in iv)) if iv else "",
+                         "fit": s.get("fit_quality", {}).get("status", ""),
+                         "misfit_per_feature": round(s.get("fit_quality", {}).get("misfit_per_feature", float("nan")), 2)})
+    return pd.DataFrame(rows)
+
+
+def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: bool = False,
+                       force: bool = False, argv=None, diagnosis=None, progress=print, **inversion) -> dict:
+    """Diagnose ``dataset``, then invert it nominal and, on a clear verdict, corrected.
+
+    Parameters
+    ----------
+    dataset, out : str or Path
+        Dataset folder; run folder to create (refused if non-empty unless ``force``).
+    workers, seed, quick : see :func:`inverse.cli.run_inversion`.
+    diagnosis : str or Path, optional
+        An existing diagnosis run folder of this dataset to use instead of diagnosing again.
+    progress : callable
+        One-line progress messages.
+    **inversion
+        Further keyword arguments of :func:`inverse.cli.run_inversion` (not ``effects``).
+
+    Returns
+    -------
+    dict
+        The chosen inversion's summary with ``closed_loop`` added.
+    """
+    from diagnosis.pipeline import diagnose
+    from drives.format import swap_into_place, temp_folder_beside
+    from inverse.cli import _check_out, run_inversion
+    from inverse.report import write_table
+    from studies.runs import write_json_atomic
+
+    if "effects" in inversion:
+        raise EroadInputError("--effects auto and explicit --effect values cannot be combined")
+    out = Path(out)
+    _check_out(out, force)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    work = temp_folder_beside(out)
+    try:
+        if diagnosis is not None:
+            dsum = json.loads((Path(diagnosis) / "summary.json").read_text())
+            shutil.copytree(diagnosis, work / "diagnose")
+        else:
+            progress("closed loop: diagnosing the nominal model's gap ...")
+            dsum = diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed)
+        effects, reason = effects_from_diagnosis(dsum)
+        progress(f"closed loop: {reason}")
+        progress("closed loop: nominal inversion ...")
+        nominal = run_inversion(dataset, work / "nominal", workers=workers, seed=seed, quick=quick,
+                                argv=argv, **inversion)
+        if effects:
+            progress("closed loop: corrected inversion ...")
+            chosen = run_inversion(dataset, work / "corrected", workers=workers, seed=seed, quick=quick,
+                                   effects=effects, argv=argv, **inversion)
+            main = work / "corrected"
+            (work / "nominal").rename(main / "nominal")
+        else:
+            chosen, main = nominal, work / "nominal"
+        (work / "diagnose").rename(main / "diagnose")
+        chosen["closed_loop"] = {
+            "verdict": dsum.get("verdict"), "confidence": dsum.get("verdict_confidence"),
+            "effects": effects or {}, "corrected": bool(effects), "reason": reason,
+            "diagnosis": "diagnose/summary.json",
+            "nominal_segments": nominal["segments"] if effects else None,
+            "nominal_fit_quality": nominal.get("fit_quality") if effects else None}
+        write_table(compare_table(nominal["segments"], chosen["segments"] if effects else []),
+                    main / "tables" / "table1_nominal_vs_corrected",
+                    note=f"Closed loop: {reason}.")
+        write_json_atomic(main / "summary.json", chosen)
+        swap_into_place(main, out)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return chosen

@@ -1,0 +1,66 @@
+"""The closed loop (diagnosis.closed_loop): which verdicts lead to a corrected inversion, and
+the run folder it writes."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from diagnosis.closed_loop import effects_from_diagnosis, invert_closed_loop
+
+CLEAR = {"verdict": "leaf_friction", "verdict_confidence": "clear",
+         "ranking": [{"effect": "payload", "parameters": {"payload": {"mass": 900.0}}},
+                     {"effect": "leaf_friction", "parameters": {"leaf_friction": {"force": 2200.0}}}]}
+
+
+@pytest.mark.parametrize("summary, expect", [
+    (CLEAR, {"leaf_friction": {"force": 2200.0}}),
+    ({**CLEAR, "verdict_confidence": "ambiguous"}, None),
+    ({**CLEAR, "verdict": "none", "verdict_confidence": "none"}, None),
+    ({**CLEAR, "verdict": "unexplained", "verdict_confidence": "clear"}, None),
+    ({**CLEAR, "ranking": []}, None),
+])
+def test_only_a_clear_named_effect_is_used(summary, expect):
+    """The verdict's own ranking entry gives the parameters (not the first entry); anything
+    short of a clear effect keeps the nominal model, with the reason in one line."""
+    effects, reason = effects_from_diagnosis(summary)
+    assert effects == expect
+    assert "\n" not in reason and (("inverted with leaf_friction.force=2200" in reason) == bool(expect))
+
+
+def test_run_folder_with_a_given_diagnosis(tmp_path):
+    """With a diagnosis that names leaf friction (given, so the test exercises the loop and not
+    the diagnosis): RUN holds the corrected inversion, nominal/ and diagnose/ beside it, the
+    side-by-side table, and summary.json's closed_loop; the corrected fit ran with the effect
+    (config.toml) and differs from the nominal one."""
+    from drives.synth import synth_command
+
+    ds = tmp_path / "ds"
+    synth_command(scenario="random", seed=5, duration=8.0, out=ds)
+    diag = tmp_path / "diag"
+    diag.mkdir()
+    (diag / "summary.json").write_text(json.dumps(CLEAR))
+    (diag / "report.md").write_text("# given\n")
+    run = tmp_path / "run"
+    s = invert_closed_loop(ds, run, workers=1, seed=0, diagnosis=diag, progress=lambda m: None,
+                           segments=1, max_iter=2, candidates=1)
+    assert s["closed_loop"]["corrected"] and s["closed_loop"]["effects"] == {"leaf_friction": {"force": 2200.0}}
+    for f in ("summary.json", "config.toml", "road.npz", "nominal/summary.json", "diagnose/report.md",
+              "tables/table1_nominal_vs_corrected.md", "tables/table1.md"):
+        assert (run / f).is_file(), f
+    assert "leaf_friction" in (run / "config.toml").read_text()
+    assert "leaf_friction" not in json.loads((run / "nominal" / "summary.json").read_text()).get("closed_loop", {})
+    nom = s["closed_loop"]["nominal_segments"][0]["Gq_n0"]
+    assert s["segments"][0]["Gq_n0"] != nom
+    assert json.loads((run / "summary.json").read_text())["closed_loop"]["reason"].startswith("the diagnosis named")
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".run.tmp")]
+
+
+def test_cli_refuses_auto_with_explicit_effects(tmp_path, capsys):
+    from eroad.cli import main
+
+    assert main(["invert", str(tmp_path), "--out", str(tmp_path / "r"), "--effects", "auto",
+                 "--effect", "leaf_friction=2000"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("eroad: error:") and "cannot be combined" in err and "\n" not in err
+    assert not (tmp_path / "r").exists()
