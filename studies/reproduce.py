@@ -14,10 +14,10 @@ step        paper items                             code
 ==========  ======================================  ==========================================
 dataset     (input)                                 drives.synth.default_dataset
 fig4_5      Figures 4, 5                            drives.figures.plot_figures
-invert      Figures 6, 8, 9; Tables 1, 2; road      inverse.cli.run_inversion
+invert      Figures 6, 8, 9; Tables 1, 2; road      diagnosis.closed_loop.invert_closed_loop
 figure11    Figure 11 and the findings table        studies.figure11.run_figure11
 chassis     chassis-stiffness study                 studies.chassis_study.run_chassis_study
-diagnose    sim-to-real gap of the dataset          diagnosis.pipeline.diagnose_dataset
+diagnose    sim-to-real gap of the dataset          (the invert step's diagnosis, copied)
 ==========  ======================================  ==========================================
 
 The run folder is written under a temporary name beside ``--out`` and renamed into
@@ -46,6 +46,8 @@ MANIFEST = [
     ("Figure 9", "invert", "figures/figure9_amplitude_distributions.png", "inverse.cli.run_inversion"),
     ("Table 2", "invert", "tables/table2.md", "inverse.cli.run_inversion"),
     ("Global road (section 2.5)", "invert", "road.npz", "inverse.cli.run_inversion"),
+    ("Table 1, nominal vs corrected model", "invert", "tables/table1_nominal_vs_corrected.md",
+     "diagnosis.closed_loop.invert_closed_loop"),
     ("Figure 11", "figure11", "figures/figure11.png", "studies.figure11.run_figure11"),
     ("Findings of section 5 (true/false)", "figure11", "data/findings.md",
      "studies.figure11.run_figure11"),
@@ -79,10 +81,12 @@ def _step_fig4_5(run: Path, quick: bool, workers: int, log) -> dict:
 
 
 def _step_invert(run: Path, quick: bool, workers: int, log) -> dict:
-    from inverse.cli import run_inversion
+    """The loop closed: diagnose, invert nominal and, on a clear verdict, with the named
+    effect (diagnosis.closed_loop); the chosen road goes on to Figure 11 and the chassis study."""
+    from diagnosis.closed_loop import invert_closed_loop
 
-    return _jsonable(run_inversion(run / "dataset", run / "invert", quick=quick,
-                                   workers=workers, seed=0, argv=sys.argv))
+    return _jsonable(invert_closed_loop(run / "dataset", run / "invert", quick=quick, workers=workers,
+                                        seed=0, argv=sys.argv, progress=log))
 
 
 def _identified_road(run: Path) -> Path:
@@ -129,8 +133,14 @@ def _step_chassis(run: Path, quick: bool, workers: int, log) -> dict:
 
 
 def _step_diagnose(run: Path, quick: bool, workers: int, log) -> dict:
+    """The diagnosis the invert step already ran (its first stage), copied to diagnose/;
+    run afresh only when the invert step was not run."""
     from diagnosis.pipeline import diagnose_dataset
 
+    made = run / "invert" / "diagnose"
+    if (made / "summary.json").is_file():
+        shutil.copytree(made, run / "diagnose")
+        return _jsonable(json.loads((made / "summary.json").read_text()))
     return _jsonable(diagnose_dataset(run / "dataset", run / "diagnose", quick=quick,
                                       workers=workers))
 
