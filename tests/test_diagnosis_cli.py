@@ -101,18 +101,27 @@ def test_road_fit_recovers_waviness(tmp_path):
 @pytest.mark.slow
 def test_blind_cases(tmp_path):
     """Blind check (issue 7, item 2) on a small set: 6 cases (null, frame flexibility,
-    leaf friction, bump stops, damper asymmetry, payload).  Required: no confident wrong
-    attribution, the null case answered "none", and every *detectable* case (the truth
-    effect would pass the noise gate) named.  The full 30-case run is
-    ``benchmarks/bench_diagnosis.py``."""
+    leaf friction, bump stops, damper asymmetry, payload), diagnosed from copies without
+    truth/.  Scored over ALL six cases against the truth, with a fixed minimum: at least
+    5 of the 6 verdicts right, the null case "none", no confident wrong attribution.  (The
+    earlier form scored only the cases the pipeline itself judged "detectable", a
+    denominator of its own choosing that could shrink to one case.)  Why 5: these are
+    cases 0-5 of the 30-case reference run (results/diagnosis_blind/20261121-30cases-v4,
+    same seeds, strengths and settings), which had 5 of 6 right (case 3, a 10.3 mm bump
+    stop, was named damper_asymmetry "ambiguous"); the run is seeded, so fewer is a
+    regression, not chance; the documented target is top-1 >= 90 %.  The full 30-case
+    run is ``benchmarks/bench_diagnosis.py``."""
     from diagnosis.blind import run_blind
 
     out = run_blind(tmp_path, 6, seed=0, workers=2, progress=lambda m: None)
-    sc = out["score"]
-    assert sc["confident_wrong"] == 0
-    assert sc["null_none_rate"] == 1.0
-    assert sc["n_detectable"] >= 1
-    assert sc["detectable_top1_accuracy"] >= 0.8
+    res = out["results"]
+    assert len(res) == 6
+    assert [r["effect"] for r in res] == ["none", "frame_flex", "leaf_friction", "bump_stop",
+                                          "damper_asymmetry", "payload"]
+    assert sum(r["verdict"] == r["effect"] for r in res) >= 5
+    assert res[0]["verdict"] == "none"
+    assert not any(r["verdict"] not in (r["effect"], "none")
+                   and r["confidence"] == "clear" for r in res)
 
 
 def test_per_model_nuisances_tilt_and_noise():
