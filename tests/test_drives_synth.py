@@ -283,13 +283,109 @@ def _effects():
     return sorted(EFFECTS)
 
 
+def _cols(df, prefix):
+    return [c for c in df.columns if c.startswith(prefix)]
+
+
+def _band_power(x, lo, hi, fs=200.0):
+    """Welch power of ``x`` in [lo, hi) Hz (Hann, 256 samples: 0.78 Hz bins)."""
+    from scipy import signal
+
+    f, p = signal.welch(np.asarray(x, float), fs, nperseg=256)
+    return float(p[(f >= lo) & (f < hi)].sum())
+
+
+def _bump_stop(a, b):
+    # one-sided contact force (only in compression beyond the gap): its mean is > 0, so
+    # the springs carry less of the weight and the mean compression drops on every
+    # spring; the stiff stop transmits harsh forces: more body acceleration
+    for c in _cols(a, "susp_disp_"):
+        assert b[c].mean() < a[c].mean(), c
+    for c in _cols(a, "body_acc_"):
+        assert b[c].std() > a[c].std(), c
+
+
+def _damper_asymmetry(a, b):
+    # rebound damping 3x compression with the mean kept: the damper pulls harder in
+    # rebound than it pushes in compression, a net downward force on a rough road, so
+    # the vehicle sits lower ("jacking down"): mean compression grows on every spring
+    for c in _cols(a, "susp_disp_"):
+        assert b[c].mean() > a[c].mean(), c
+
+
+def _frame_flex(a, b):
+    # the rigid chassis cannot twist; the flexible frame's torsion modes (6, 7.8 Hz) let
+    # front and rear roll against each other, which the left-right road difference
+    # excites: the left-right difference of the body accelerations grows at every axle
+    for ax in sorted({c[len("body_acc_"):-1] for c in _cols(a, "body_acc_")}):
+        da = a[f"body_acc_{ax}L"] - a[f"body_acc_{ax}R"]
+        db = b[f"body_acc_{ax}L"] - b[f"body_acc_{ax}R"]
+        assert db.std() > da.std(), ax
+
+
+def _leaf_friction(a, b):
+    # inter-leaf friction holds the spring until the force exceeds it: less travel on
+    # every spring
+    for c in _cols(a, "susp_disp_"):
+        assert b[c].std() < a[c].std(), c
+
+
+def _payload(a, b):
+    # 2 t more on the frame, outputs zeroed at the nominal vehicle's static state: every
+    # spring is compressed further on average
+    for c in _cols(a, "susp_disp_"):
+        assert b[c].mean() > a[c].mean(), c
+
+
+def _sensor(a, b):
+    # causal 2nd-order Butterworth at 40 Hz: |H|^2 = 1 / (1 + (f/40)^4) = 0.5-0.87 in
+    # 25-40 Hz, where the road's axle acceleration (not the 0.05 m/s^2 noise, whose
+    # PSD is 2.5e-5 (m/s^2)^2/Hz) dominates: less axle-acceleration power there.  The
+    # added 0.2 mm displacement noise raises the floor of susp_disp above 60 Hz, where
+    # the suspension motion itself is negligible
+    for c in _cols(a, "axle_acc_"):
+        assert _band_power(b[c], 25.0, 40.0) < _band_power(a[c], 25.0, 40.0), c
+    for c in _cols(a, "susp_disp_"):
+        assert _band_power(b[c], 60.0, 100.0) > _band_power(a[c], 60.0, 100.0), c
+
+
+def _speed_scale(a, b):
+    # the recorded speed is factor (1.02) x the true speed; nothing else changes (the
+    # speed noise stream is the same, so the mean ratio is the factor to ~1e-6)
+    assert b["speed"].mean() / a["speed"].mean() == pytest.approx(1.02, abs=1e-4)
+    others = [c for c in a.columns if c != "speed"]
+    assert np.array_equal(a[others].to_numpy(), b[others].to_numpy())
+
+
+def _tyre_enveloping(a, b):
+    # the footprint averages the road over its length L (0.22-0.25 m): sinc(n L)^2 halves
+    # the road power at n = 0.44 / L ~ 2 cycles/m (about 20 Hz at 8-11 m/s) and removes
+    # it at 1 / L, so the axles, which see the road through the tyres alone, accelerate
+    # less
+    for c in _cols(a, "axle_acc_"):
+        assert b[c].std() < a[c].std(), c
+
+
+#: effect -> the direction its physics predicts on the short dataset (see each function)
+DIRECTIONS = {"bump_stop": _bump_stop, "damper_asymmetry": _damper_asymmetry,
+              "frame_flex": _frame_flex, "leaf_friction": _leaf_friction, "payload": _payload,
+              "sensor": _sensor, "speed_scale": _speed_scale, "tyre_enveloping": _tyre_enveloping}
+
+
 @pytest.mark.parametrize("effect", _effects())
-def test_each_effect_changes_the_data(short_cfg, short_ds, tmp_path, effect):
+def test_each_effect_changes_the_data_in_its_physical_direction(short_cfg, short_ds, tmp_path, effect):
     """Every effect of the library, switched on in the truth vehicle, changes the dataset
     (same seed, so road, speed and noise streams are identical and any difference is the
-    effect's). Threshold: the largest relative RMS change over the channels (speed
-    included, which speed_scale acts on) exceeds 1e-3, far above round-off (1e-15) and
-    far below the effects' sizes."""
+    effect's), and in the direction its physics predicts (``DIRECTIONS``: a bump stop
+    lowers the mean compression and raises the body acceleration, asymmetric dampers
+    and payload raise the mean compression, leaf friction lowers the travel, the
+    flexible frame raises the left-right body difference, the sensor low-pass lowers
+    the axle acceleration below its cutoff, speed_scale raises the recorded speed by
+    its factor, tyre enveloping lowers the axle acceleration).  Every effect needs a
+    direction here.  Size threshold: the largest relative RMS change over the channels
+    (speed included, which speed_scale acts on) exceeds 1e-3, far above round-off
+    (1e-15) and far below the effects' sizes."""
+    assert effect in DIRECTIONS, f"effect {effect!r} has no physical direction in this test"
     out = tmp_path / effect
     assert main(["synth", "--config", str(short_cfg), "--seed", "3", "--effect",
                  EFFECT_ARGS.get(effect, effect), "--out", str(out)]) == 0
@@ -297,6 +393,7 @@ def test_each_effect_changes_the_data(short_cfg, short_ds, tmp_path, effect):
     b = read_drive(out).to_dataframe().drop(columns="time")
     rel = np.sqrt(((a - b) ** 2).mean()) / np.sqrt((a ** 2).mean())
     assert rel.max() > 1e-3, rel.sort_values().tail(3)
+    DIRECTIONS[effect](a, b)
     truth = synth.read_truth(out)
     assert effect in truth["vehicle"]["truth"]["effects"]
 

@@ -25,8 +25,8 @@ import pytest
 from eroad.cli import main
 from studies.figure11 import (CRITERIA, _solve_exact_with_yaw, development_road,
                               drive_base_motion, evaluate_findings, findings_markdown,
-                              kinematics_check, load_figure11, simulate_tractor, tractor_variant,
-                              write_findings)
+                              kinematics_check, load_figure11, plot_figure11, simulate_tractor,
+                              tractor_variant, write_findings)
 from studies.pantograph import check_points, point_displacements, solve_base_motion
 
 FS = 200.0
@@ -130,7 +130,14 @@ def test_findings_files(tmp_path):
 
 
 def test_eroad_study_pantograph_archives_a_run(short_road, tmp_path, capsys):
-    """`eroad study pantograph` writes data, findings, figure and summary; plot from data."""
+    """`eroad study pantograph` archives a complete run: data, findings, figure and
+    summary on disk, consistent with each other.  Checked beyond the files' presence:
+    run.json says complete; the summary's verdicts are those of findings.json, which are
+    those :func:`evaluate_findings` gives on the archived data read back (the findings
+    come from the files, not from memory); the figure is a decodable PNG and can be
+    drawn again from the archived data alone (``plot_figure11`` never simulates)."""
+    import matplotlib.image as mpimg
+
     _, path = short_road
     rc = main(["study", "pantograph", "--road", str(path), "--out", str(tmp_path),
                "--duration", "7", "--json"])
@@ -143,12 +150,26 @@ def test_eroad_study_pantograph_archives_a_run(short_road, tmp_path, capsys):
                  "data/modes.json", "data/modal_contributions.npz", "data/findings.json",
                  "data/findings.md", "data/kinematics_check.json", "figures/figure11.png",
                  "figures/figure11.pdf", "summary.json", "run.json", "config.toml"):
-        assert (folder / name).is_file(), name
-    assert set(summary["findings"]) == set("abcde")
-    assert summary["kinematics_check"]["exact_max_rel_error"] < 1e-9
+        assert (folder / name).is_file() and (folder / name).stat().st_size > 0, name
+    assert json.loads((folder / "run.json").read_text())["status"] == "complete"
+    assert json.loads((folder / "summary.json").read_text())["findings"] == summary["findings"]
+    # findings: summary == findings.json == re-evaluated from the archived data
+    on_disk = {f["id"]: f["holds"] for f in json.loads((folder / "data/findings.json").read_text())["findings"]}
+    assert summary["findings"] == on_disk and set(on_disk) == set("abcde")
     data = load_figure11(folder / "data")
+    again = evaluate_findings(data.motion, data.fs, data.modes, data.contributions)
+    assert {f.id: bool(f.holds) for f in again} == on_disk
+    md = (folder / "data/findings.md").read_text()
+    assert md.count("**true**") == sum(on_disk.values())
+    assert md.count("**false**") == 5 - sum(on_disk.values())
+    assert summary["kinematics_check"]["exact_max_rel_error"] < 1e-9
     assert set(data.spectra) >= {"Rx", "Rx_vel", "Rx_acc", "Ty_acc", "Tz_vel", "Ry_acc"}
     assert data.contributions["ratio"].shape[2] == 4
+    # the figure: a PNG, and drawn again from the data alone
+    img = mpimg.imread(folder / "figures/figure11.png")
+    assert img.ndim == 3 and min(img.shape[:2]) >= 200 and float(np.std(img[..., :3])) > 0.01
+    redrawn = plot_figure11(folder / "data", tmp_path / "redrawn.png", pdf=False)
+    assert [p.suffix for p in redrawn] == [".png"] and redrawn[0].stat().st_size > 10_000
     # a missing road file is one line and exit code 2
     rc = main(["study", "pantograph", "--road", str(tmp_path / "nope.npz"), "--out",
                str(tmp_path)])
