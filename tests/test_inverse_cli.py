@@ -73,10 +73,16 @@ def test_bad_input_is_one_line(short_drive, tmp_path, capsys):
 def test_blind_benchmark_no_model_gap(tmp_path, capsys):
     """Accuracy against truth (benchmarks/bench_inverse.py) on 3 blind random drives whose
     truth vehicle has no leaf friction (no model gap; still the flexible frame, 1 ms step,
-    sensor noise).  About 3-5 min.  Bounds (docs/inverse.md, section 10): the level of
-    segments >= 8 s within a factor 2 (|ln| < ln 2) at the median and w within 0.3 at the
-    median: loose on purpose, the Cramer-Rao floor of ln Gq for 80-100 m is 0.11-0.14 and
-    3 drives give only a handful of long segments."""
+    sensor noise).  About 3-5 min.  Bounds (docs/inverse.md, section 10): the level within a
+    factor 2 (|ln| < ln 2) and w within 0.3 at the median, for the segments >= 8 s and for
+    those >= 3 s: loose on purpose, the Cramer-Rao floor of ln Gq for 80-100 m is 0.11-0.14
+    and 3 drives give only a handful of long segments (null benchmark: median 0.109 for
+    >= 8 s, 0.242 for >= 3 s).
+
+    Every case must have been inverted and scored (no skip), and the segments must be there
+    to judge: seeds 1-3 hold 3 true segments >= 8 s (26.5, 14.2, 8.5 s) and 10 >= 3 s; should
+    a seed be refused by the format (then 4 replaces it) there are still >= 3 and >= 8, so
+    fewer than that fails the test instead of letting it pass on nothing."""
     import importlib.util
     import math
     from pathlib import Path
@@ -89,12 +95,16 @@ def test_blind_benchmark_no_model_gap(tmp_path, capsys):
     spec.loader.exec_module(bench)
     assert bench.main(["--cases", "3", "--no-default-effects", "--root", str(tmp_path), "--max-iter", "8"]) == 0
     out = capsys.readouterr().out
-    assert "| >= 3 s |" in out or "| all |" in out
-    cases = [json.loads(x) for x in (tmp_path / "results.jsonl").read_text().splitlines()]
-    segs = [r for c in cases if "skipped" not in c for r in c["segments"] if r["duration_s"] >= 8.0]
-    if segs:
-        assert np.median([r["dlnGq"] for r in segs]) < math.log(2.0)
-        assert np.median([r["dw"] for r in segs]) < 0.3
+    assert "| >= 3 s |" in out and "| >= 8 s |" in out
+    lines = [json.loads(x) for x in (tmp_path / "results.jsonl").read_text().splitlines()]
+    cases = [c for c in lines if "skipped" not in c]
+    assert len(cases) == 3, [c.get("seed") for c in lines]
+    assert all(c["segments"] for c in cases)
+    for min_s, min_count in ((8.0, 3), (3.0, 8)):
+        segs = [r for c in cases for r in c["segments"] if r["duration_s"] >= min_s]
+        assert len(segs) >= min_count, (min_s, len(segs))
+        assert np.median([r["dlnGq"] for r in segs]) < math.log(2.0), min_s
+        assert np.median([r["dw"] for r in segs]) < 0.3, min_s
 
 
 def test_noise_option_parsing_and_psd():
@@ -111,3 +121,92 @@ def test_noise_option_parsing_and_psd():
             _noise(bad)
     with pytest.raises(EroadInputError, match="matches no channel"):
         noise_psd_from_sd({"wheel": 0.1}, ["axle_acc_3L"], fs=200.0)
+
+
+# --------------------------------------------------------------------------- accuracy of the truck inversion
+
+#: the single-segment drive: class C at its geometric mean, w = 2
+TRUTH_GQ, TRUTH_W = 256e-6, 2.0
+
+
+@pytest.fixture(scope="module")
+def single_class_drive(tmp_path_factory):
+    """A 15 s ``null`` drive (truth vehicle = the nominal rigid model; its own road grid,
+    phases, smooth random speed 6-14 m/s and sensor noise) over ONE class C segment
+    (Gq_n0 = 256e-6 m^3, w = 2, band 0.1-5 cycles/m), seed 3; and its copy without truth/."""
+    from drives.synth import load_scenario, resolve_scenario, synthesize
+
+    root = tmp_path_factory.mktemp("invert_single")
+    cfg, src = load_scenario("null")
+    cfg["road"]["segments"] = [{"proportion": 1.0, "Gq_n0": TRUTH_GQ, "w": TRUTH_W, "nmin": 0.1, "nmax": 5.0}]
+    cfg = resolve_scenario(cfg, 3, duration=15.0, src=src)
+    ds = root / "ds"
+    synthesize(cfg, ds)
+    return ds, copy_without_truth(ds, root / "blind"), root
+
+
+def test_truck_inversion_recovers_a_single_class_road(single_class_drive):
+    """``run_inversion`` with the Exudyn truck on a blind 15 s single-segment drive (K = 1
+    given, default iterations, fit phases only): class C and |ln(Gq_fit / Gq_true)| < ln 2,
+    |w - 2| < 0.3.
+
+    Bounds from docs/inverse.md section 10 (null scenario, no model gap): on segments >= 8 s
+    the median |ln Gq| is 0.109, the worst 0.78, the class right in 95 % and w within 0.15 in
+    86 % (worst 0.45).  The truth sits at the centre of class C, so |ln Gq| < ln 2 = 0.69 is
+    the same as the class being right; 0.3 in w is twice the largest error measured on this
+    set-up.  Measured by hand on this drive with seeds 1-5 (seed 3 is the test's):
+    ln Gq error -0.004, -0.046, -0.107, -0.353, -0.334; w error +0.007, -0.037, -0.029,
+    -0.148, -0.115 (ln Gq follows w with the lever ln(n_data / n0) ~ 2.3).  About 30 s
+    (60 simulations of 17 s of truck, serial)."""
+    import math
+
+    from drives.synth import read_truth
+
+    ds, blind, root = single_class_drive
+    truth = read_truth(ds)["segments"]
+    assert len(truth) == 1 and truth[0]["Gq_n0"] == pytest.approx(TRUTH_GQ)
+    s = run_inversion(blind, root / "run", segments=1, workers=1, seed=0, candidates=0)
+    (seg,) = s["segments"]
+    assert seg["class"] == "C"
+    assert abs(math.log(seg["Gq_n0"] / TRUTH_GQ)) < math.log(2.0), seg["Gq_n0"]
+    assert abs(seg["w"] - TRUTH_W) < 0.3, seg["w"]
+    assert s["fit"]["iterations"] >= 2   # a real fit, not the start point
+
+
+def test_effect_option_reaches_the_simulation(short_drive, tmp_path):
+    """``eroad invert --effect payload=15000``: the effect is in config.toml, and Table 2 of
+    the run is the response of the model WITH it: a TruckSimulator built here with
+    effects={'payload': 15000} on the run's fitted segments and the fit's phase seed
+    (SeedSequence(0, (5, 1)); --candidates 0 keeps the fit's phases) reproduces every
+    rms_sim to 1e-9 (deterministic: the same simulation), while the nominal model on the same
+    road gives RMS values that differ by more than 1 % (15 t of payload moves the body
+    bounce: measured several %).  Smoke-size: K = 1, one iteration, serial."""
+    import math
+
+    import numpy as np
+
+    from drives.format import read_drive
+    from inverse.truck import TruckSimulator
+
+    ds, _, _ = short_drive
+    out = tmp_path / "run_payload"
+    assert main(["invert", str(ds), "--out", str(out), "--effect", "payload=15000", "--segments", "1",
+                 "--workers", "1", "--max-iter", "1", "--candidates", "0"]) == 0
+    import tomllib
+    cfg = tomllib.loads((out / "config.toml").read_text())
+    assert json.loads(cfg["effects"]) == {"payload": {"mass": 15000.0}}
+    s = json.loads((out / "summary.json").read_text())
+    segs = s["segments"]
+    params = np.array([[r["Gq_n0"], r["w"], r["nmin"], r["nmax"]] for r in segs])
+    t_bounds = [segs[0]["t_start"]] + [r["t_end"] for r in segs]
+    drive = read_drive(ds)
+    rows = {r["channel"]: r for r in s["table2"]}
+    chans = sorted(rows)
+    fit_seed = int(np.random.SeedSequence(0, spawn_key=(5, 1)).generate_state(1)[0])
+    kw = dict(time=np.asarray(drive.time, float), speed=np.asarray(drive.speed, float), t_bounds=t_bounds,
+              channels=chans)
+    with_effect = TruckSimulator(drive.vehicle, effects={"payload": 15000.0}, **kw)(params, fit_seed)
+    nominal = TruckSimulator(drive.vehicle, **kw)(params, fit_seed)
+    for c in chans:
+        assert rows[c]["rms_sim"] == pytest.approx(float(np.std(with_effect[c])), rel=1e-9), c
+    assert max(abs(math.log(np.std(nominal[c]) / rows[c]["rms_sim"])) for c in chans) > 0.01
