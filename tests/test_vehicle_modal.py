@@ -306,8 +306,9 @@ def test_dcdc_modes_tractor(results):
     springs.  What the two-body estimates leave out is the chassis's suspension and
     tyres and the axles behind them: at the mount modes (16-43 Hz) these add at most
     (3.3 / 16)^2 = 4 % to the chassis side's dynamic stiffness, which enters the mode
-    only through the m / m_eff correction (13-50 % of the eigenvalue), so < 2 % of the
-    eigenvalue and < 1 % of the frequency; measured deviations 0.0-0.9 %.  3 % keeps
+    only through the chassis-side correction (2-43 % of the eigenvalue against fixed
+    ground), so < 2 % of the eigenvalue and < 1 % of the frequency; measured deviations
+    0.0-0.9 %.  3 % keeps
     that with margin and fails for a 10 % change of the mount stiffness or of the
     block's mass (4.9 % in frequency).  The dump truck has no DCDC modes."""
     doc = _toml("e_tractor")

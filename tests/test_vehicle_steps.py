@@ -11,12 +11,14 @@ called without ``dt``, so whatever the default is, it is what is tested).
 
 Why 10 s: the error of a step is set by the period error at the axle-hop and frame /
 DCDC resonances (9-43 Hz), which a 10 s record resolves with hundreds of cycles; the
-measured worst channels at the default steps (0.61-0.66 % for the truck, 0.33 % / 0.64 %
-for the tractor, rigid / flexible) agree with the benchmark's 30 s values (0.62-0.65 %,
-0.32 % / 0.62 %) within 0.05 %, and on five road seeds they stay within 0.53-0.72 %.  One
-step up is not good enough: twice the default (5 ms truck, 2.5 ms tractor) misses the
-criterion on this road (1.23-1.34 % truck, 1.28 % flexible tractor), so a default step
-that grew by 2x fails this test.  The whole file runs in about 6 s.
+measured worst channels at the default steps (truck 0.66 % rigid, 0.61 % flexible;
+tractor 0.33 % rigid, 0.64 % flexible) agree with the benchmark's 30 s values (0.65 %,
+0.62 %, 0.33 %, 0.62 %) within 0.05 %, and on five road seeds (8 s) they stay within
+0.32-0.72 %.  Twice the default step misses the criterion on this road (truck at 5 ms:
+1.34 % rigid, 1.23 % flexible; flexible tractor at 2.5 ms: 1.28 %), so a default step
+that doubled fails this test; the rigid tractor alone would pass at 2.5 ms (0.66 %):
+its step is set by the flexible frame's and the DCDC block's modes (docs/vehicles.md).
+The whole file takes about 6 s of CPU.
 """
 from __future__ import annotations
 
