@@ -65,6 +65,9 @@ def register(subparsers) -> None:
                    help="known white sensor noise, standard deviation in the channel's SI unit, for a "
                         "channel (susp_disp_3L=1e-4) or a quantity (axle_acc=0.03); repeatable; channels "
                         "not given are estimated from the top of their spectrum")
+    p.add_argument("--fit", choices=("simulation", "linear"), default="simulation",
+                   help="fit model: 'simulation' (every evaluation a time simulation; default) or 'linear' "
+                        "(linear-model features corrected by a few time simulations, docs/inverse.md section 12)")
     p.add_argument("--quick", action="store_true", help="few iterations and candidates (smoke runs)")
     p.add_argument("--json", action="store_true", help="print summary.json to stdout")
     p.add_argument("--force", action="store_true", help="replace an existing RUN")
@@ -74,7 +77,7 @@ def register(subparsers) -> None:
 def _cmd_invert(args) -> int:
     common = dict(segments=args.segments, workers=args.workers, seed=args.seed, quick=args.quick,
                   force=args.force, candidates=args.candidates, max_iter=args.max_iter,
-                  channels=args.channels, noise_sd=_noise(args.noise), argv=sys.argv)
+                  channels=args.channels, noise_sd=_noise(args.noise), argv=sys.argv, fit_model=args.fit)
     if args.effects == "auto":
         if args.effect:
             raise EroadInputError("--effects auto and --effect NAME=VALUE cannot be combined")
@@ -181,7 +184,8 @@ def _check_out(out: Path, force: bool) -> None:
 
 def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 0, quick: bool = False,
                   force: bool = False, candidates=None, max_iter=None, effects=None, chassis: str = "rigid",
-                  channels="axle3", argv=None, polish: bool = True, noise_sd=None) -> dict:
+                  channels="axle3", argv=None, polish: bool = True, noise_sd=None,
+                  fit_model: str = "simulation") -> dict:
     """Invert a dataset into the run folder ``out`` (see the module docstring).
 
     Parameters
@@ -212,6 +216,9 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     noise_sd : dict, optional
         Known white sensor noise: channel or quantity (``axle_acc``) -> standard
         deviation [SI unit of the channel]; the rest is estimated.
+    fit_model : {"simulation", "linear"}
+        The fit's model (:class:`inverse.pipeline.InversionConfig`); recorded in
+        ``summary["fit"]["model"]`` and config.toml.
     polish : bool
         The fit's final polishing step over several road realisations
         (:class:`inverse.sensitivity.FitConfig` ``polish_replicates``); off only to
@@ -259,7 +266,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     bounds = ParamBounds(nmax=(1.0, nmax_cap(SIM_DX)))
     fs = 1.0 / float(np.median(np.diff(time)))
     noise_psd = noise_psd_from_sd(noise_sd, list(drive.channel_names), fs) if noise_sd else None
-    icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd)
+    icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd,
+                           fit_model=fit_model)
     make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans))
     predict = TruckPredictRms(drive.vehicle, ("susp_disp_3L", "susp_disp_3R"), chassis=chassis, effects=effects)
 
@@ -348,6 +356,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                "noise_sd": dict(noise_sd or {}), "polish": bool(polish),
                "workers": workers, "seed": seed, "quick": quick, "candidates": n_cand, "max_iter": iters,
                "chassis": chassis, "channels": list(chans), "effects": json.dumps(effects or {}),
+               "fit_model": fit_model,
                "simulator": {"dx_m": SIM_DX, "nmax_cap_cpm": nmax_cap(SIM_DX)},
                "bounds": {k: list(getattr(bounds, k)) for k in ("Gq_n0", "w", "nmin", "nmax")}}
         (tmp / "config.toml").write_text(tomli_w.dumps(cfg))

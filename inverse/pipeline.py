@@ -68,6 +68,13 @@ class InversionConfig:
         Channel -> known white sensor-noise PSD [unit^2/Hz] (e.g. from the data
         sheet: sd^2 / (fs / 2)); channels not given are estimated from the top
         of their spectrum (:func:`inverse.features.estimate_noise_psd`).
+    fit_model : {"simulation", "linear"}
+        "simulation": every feature evaluation of the fit is a time simulation
+        (:func:`inverse.sensitivity.fit_segments`); "linear": the linear model's
+        expected features with simulation offsets (:func:`inverse.linear_features.fit_hybrid`,
+        docs/inverse.md section 12).
+    linear_corrections : int
+        Most simulate-and-refit rounds of the "linear" fit (0: linear model alone).
     """
 
     k: int | None = None
@@ -83,6 +90,8 @@ class InversionConfig:
     nmax_prior: float = 5.0
     seed: int = 0
     noise_psd: dict | None = None
+    fit_model: str = "simulation"
+    linear_corrections: int = 2
 
 
 @dataclass
@@ -147,7 +156,7 @@ class Inversion:
     def summary(self) -> dict:
         """JSON-ready summary: segments, fit statistics, iteration history."""
         return {"segments": self.segments(),
-                "fit": {"n_sims": self.fit.n_sims, "wall_s": self.fit.wall_s,
+                "fit": {"model": self.config.fit_model, "n_sims": self.fit.n_sims, "wall_s": self.fit.wall_s,
                         "iterations": sum(h.get("kind") == "trust_region" for h in self.fit.history[1:]),
                         "polished": any(h.get("kind") == "polish" for h in self.fit.history),
                         "objective": float(self.fit.history[-1]["objective"]),
@@ -158,7 +167,7 @@ class Inversion:
 
 def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
            segment_channels=None, config: InversionConfig = InversionConfig(),
-           map_fn=None, progress=None) -> Inversion:
+           map_fn=None, progress=None, linear_model=None) -> Inversion:
     """Segment a drive and fit the road spectrum of every segment.
 
     Parameters
@@ -186,11 +195,17 @@ def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
         Parallel map for the sampled simulations (see :func:`fit_segments`).
     progress : callable, optional
         Called with each fit history entry.
+    linear_model : vehicles.linear.LinearModel, optional
+        The linear model of ``config.fit_model == "linear"``; default built from the
+        simulator's ``vehicle``, ``chassis`` and ``effects`` (its linear effects,
+        :func:`inverse.linear_features.linear_model_for`).
 
     Returns
     -------
     Inversion
     """
+    if config.fit_model not in ("simulation", "linear"):
+        raise EroadInputError(f"fit_model must be 'simulation' or 'linear', got {config.fit_model!r}")
     t = np.asarray(time, dtype=float)
     if segment_channels is None:
         segment_channels = sorted(c for c in channels if c.startswith("susp_disp_3")) or \
@@ -213,8 +228,24 @@ def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
     v_max = float(np.max(np.broadcast_to(np.asarray(speed, float), t.shape)))
     bounds = config.bounds.for_record(fs, v_max)
     simulate = make_simulator(seg.t_bounds)
-    fit = fit_segments(simulate, feats, params0, seed=stream_seed(config.seed, SEED_KEY_FIT),
-                       bounds=bounds, config=config.fit, prior=prior, map_fn=map_fn, progress=progress)
+    if config.fit_model == "linear":
+        from inverse.linear_features import LinearFeatures, fit_hybrid, linear_model_for, road_grid_lines
+
+        if linear_model is None:
+            if not hasattr(simulate, "vehicle"):
+                raise EroadInputError("invert: fit_model 'linear' needs linear_model= or a simulator with a vehicle")
+            linear_model, _ = linear_model_for(simulate.vehicle, getattr(simulate, "chassis", "rigid"),
+                                               getattr(simulate, "effects", None))
+        # the simulator's road grid (its sinc^4 loss along x, the bilinear mix of grid lines across)
+        grid_y = road_grid_lines(simulate.width, simulate.dy) if hasattr(simulate, "width") else None
+        lin = LinearFeatures(feats, speed, linear_model, grid_dx=getattr(simulate, "dx", None), grid_y=grid_y,
+                             lam=getattr(simulate, "lam", 1.0))
+        fit = fit_hybrid(simulate, feats, params0, linear=lin, seed=stream_seed(config.seed, SEED_KEY_FIT),
+                         bounds=bounds, config=config.fit, prior=prior, map_fn=map_fn, progress=progress,
+                         corrections=config.linear_corrections)
+    else:
+        fit = fit_segments(simulate, feats, params0, seed=stream_seed(config.seed, SEED_KEY_FIT),
+                           bounds=bounds, config=config.fit, prior=prior, map_fn=map_fn, progress=progress)
     return Inversion(t, seg, feats, fit, params0, config)
 
 
