@@ -159,6 +159,11 @@ def sim_spectra(simulated: Sequence, ref: Reference) -> list:
     return out
 
 
+#: smallest simulated / measured band-power ratio a cell can show [-]: a band the simulation
+#: leaves empty counts as this deficit (ln = -27.6) instead of dropping out of the gap
+ZERO_POWER_RATIO = 1e-12
+
+
 def band_gap(simulated: Sequence, ref: Reference, spectra: list | None = None) -> Gap:
     """Gap of simulated windows against a prepared measurement.
 
@@ -185,7 +190,10 @@ def band_gap(simulated: Sequence, ref: Reference, spectra: list | None = None) -
             raise EroadInputError("gap: simulated and measured windows analysed differently")
         ok = bs.nu >= ref.min_nu
         with np.errstate(divide="ignore", invalid="ignore"):
-            d.append(np.where(ok, np.log(bs.power / bm.power), np.nan))
+            # a simulated band with no power at all is a gap of 12 decades, not a cell to drop
+            # (a model that outputs nothing on a channel must not score like a good one)
+            ps = np.maximum(bs.power, ZERO_POWER_RATIO * bm.power)
+            d.append(np.where(ok, np.log(ps / bm.power), np.nan))
     d = np.array(d)
     w = np.where(np.isfinite(d), ref.weight, 0.0)
     dz = np.where(w > 0, d, 0.0)

@@ -204,3 +204,17 @@ def test_heldout_shrink_closed_form(monkeypatch):
     assert out["null_improvement_mean"] == pytest.approx(mu, rel=1e-9)
     assert out["null_improvement_sd"] == pytest.approx(sd, rel=1e-9)
     assert out["paired_z"] == pytest.approx((before - after - mu) / sd, rel=1e-9)
+
+
+def test_a_channel_the_simulation_leaves_empty_is_a_huge_gap():
+    """A simulation that reproduces channels a and c exactly but outputs zeros on b: b's cells
+    count as a 12-decade deficit (ln 1e-12 = -27.6) instead of dropping out. Two thirds of
+    the weight sits on exact cells, so the gap is about (ln 1e-12)^2 / 3 = 254 (between 100
+    and 400 whatever the per-channel weights), where dropping the cells gave about 0."""
+    rng = np.random.default_rng(3)
+    meas = [_noise(rng, 4000)]
+    sim = [Signals(meas[0].time, {c: (np.zeros_like(x) if c == "b" else x.copy())
+                                  for c, x in meas[0].channels.items()}, meta=dict(meas[0].meta))]
+    g = band_gap(sim, reference(meas))
+    assert 100.0 < g.value < 400.0
+    assert np.nanmin(g.log_ratio) == pytest.approx(math.log(1e-12))
