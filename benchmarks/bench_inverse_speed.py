@@ -84,6 +84,17 @@ def table(results: list) -> str:
                          f"{a.get('dlnG_n_best', math.nan):.3f} / {b.get('dlnG_n_best', math.nan):.3f} |")
     allseg = {f: [s for fits in by.values() if f in fits for s in fits[f]["segments"]] for f in FITS}
     lines.append("")
+    pairs = [(a, b) for fits in by.values() if all(f in fits for f in FITS)
+             for a, b in zip(fits["simulation"]["segments"], fits["linear"]["segments"])]
+    if pairs:
+        # paired per true segment: the two fits share the data, so the difference is the fits'
+        for key, lab in (("dlnGq", "abs ln Gq(n0)"), ("dw", "abs w"), ("dlnG_n_best", "abs ln G(n_best)")):
+            d = np.array([b[key] - a[key] for a, b in pairs if key in a and key in b])
+            if d.size:
+                lines.append(f"* paired, linear minus simulation, {lab}: mean {d.mean():+.3f} "
+                             f"(standard error {d.std(ddof=1) / math.sqrt(d.size) if d.size > 1 else math.nan:.3f}), "
+                             f"median {np.median(d):+.3f}; linear better in {int(np.sum(d < -0.005))}, worse in "
+                             f"{int(np.sum(d > 0.005))} of {d.size} segments (|difference| > 0.005)")
     for f in FITS:
         if allseg[f]:
             cls = np.mean([s["class_true"] == s["class_fit"] for s in allseg[f]])

@@ -74,7 +74,9 @@ class InversionConfig:
         expected features with simulation offsets (:func:`inverse.linear_features.fit_hybrid`,
         docs/inverse.md section 12).
     linear_corrections : int
-        Most simulate-and-refit rounds of the "linear" fit (0: linear model alone).
+        Most simulate-and-refit rounds of the "linear" fit (0: linear model alone);
+        at least ``inverse.linear_features.CORRECTIONS_NONLINEAR`` (4) when the
+        simulator has nonlinear effects the linear model leaves out.
     """
 
     k: int | None = None
@@ -155,8 +157,10 @@ class Inversion:
 
     def summary(self) -> dict:
         """JSON-ready summary: segments, fit statistics, iteration history."""
+        rounds = [h for h in self.fit.history if h.get("kind") == "trust_region" and "move" in h]
+        hybrid = {"corrections": len(rounds), "last_move": rounds[-1]["move"]} if rounds else {}
         return {"segments": self.segments(),
-                "fit": {"model": self.config.fit_model, "n_sims": self.fit.n_sims, "wall_s": self.fit.wall_s,
+                "fit": {"model": self.config.fit_model, **hybrid, "n_sims": self.fit.n_sims, "wall_s": self.fit.wall_s,
                         "iterations": sum(h.get("kind") == "trust_region" for h in self.fit.history[1:]),
                         "polished": any(h.get("kind") == "polish" for h in self.fit.history),
                         "objective": float(self.fit.history[-1]["objective"]),
@@ -229,20 +233,24 @@ def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
     bounds = config.bounds.for_record(fs, v_max)
     simulate = make_simulator(seg.t_bounds)
     if config.fit_model == "linear":
-        from inverse.linear_features import LinearFeatures, fit_hybrid, linear_model_for, road_grid_lines
+        from inverse.linear_features import (CORRECTIONS_NONLINEAR, LinearFeatures, fit_hybrid, linear_model_for,
+                                             road_grid_lines)
 
+        corrections = config.linear_corrections
         if linear_model is None:
             if not hasattr(simulate, "vehicle"):
                 raise EroadInputError("invert: fit_model 'linear' needs linear_model= or a simulator with a vehicle")
-            linear_model, _ = linear_model_for(simulate.vehicle, getattr(simulate, "chassis", "rigid"),
-                                               getattr(simulate, "effects", None))
+            linear_model, left_out = linear_model_for(simulate.vehicle, getattr(simulate, "chassis", "rigid"),
+                                                      getattr(simulate, "effects", None))
+            if left_out:   # offsets that depend on the road: more rounds (docs/inverse.md section 12)
+                corrections = max(corrections, CORRECTIONS_NONLINEAR)
         # the simulator's road grid (its sinc^4 loss along x, the bilinear mix of grid lines across)
         grid_y = road_grid_lines(simulate.width, simulate.dy) if hasattr(simulate, "width") else None
         lin = LinearFeatures(feats, speed, linear_model, grid_dx=getattr(simulate, "dx", None), grid_y=grid_y,
                              lam=getattr(simulate, "lam", 1.0))
         fit = fit_hybrid(simulate, feats, params0, linear=lin, seed=stream_seed(config.seed, SEED_KEY_FIT),
                          bounds=bounds, config=config.fit, prior=prior, map_fn=map_fn, progress=progress,
-                         corrections=config.linear_corrections)
+                         corrections=corrections)
     else:
         fit = fit_segments(simulate, feats, params0, seed=stream_seed(config.seed, SEED_KEY_FIT),
                            bounds=bounds, config=config.fit, prior=prior, map_fn=map_fn, progress=progress)

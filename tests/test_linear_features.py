@@ -210,3 +210,25 @@ def test_hybrid_fit_recovers_a_null_drive(null_drive):
         g_true = s["Gq_n0"] * (f["n_best"] / 0.1) ** -s["w"]
         assert abs(math.log(f["G_n_best"] / g_true)) < 0.35, (s, f)
         assert abs(f["w"] - s["w"]) < 0.3, (s, f)
+
+
+def test_additive_correction_equals_gain_at_the_correction_point(drive, lm):
+    """A power E = (P_lin + N)(e^c - 1) and a gain e^c give the same features where they
+    were taken (to rounding) and the additive one a smaller level sensitivity elsewhere:
+    d F / d ln Gq = P_lin / (P_lin + N + E) instead of P_lin / (P_lin + N)."""
+    t, v, tb, sim, fset = drive
+    lin = LinearFeatures(fset, v, lm)
+    c = [np.full(wf.y.size, 1.0) for wf in fset.windows]
+    tot = lin.band_totals(PARAMS)
+    E = [t_ * np.expm1(1.0) for t_ in tot]
+    rms = [np.array([lab.endswith(":rms") for lab in wf.labels]) for wf in fset.windows]
+    gain = lin.with_offsets(c)
+    add = lin.with_offsets([np.where(r, 1.0, 0.0) for r in rms], [np.where(r, 0.0, e) for r, e in zip(rms, E)])
+    for a, b in zip(gain(PARAMS), add(PARAMS)):
+        np.testing.assert_allclose(a, b, atol=1e-9)
+    P2 = PARAMS.copy()
+    P2[:, 0] *= 2
+    for k, r in enumerate(rms):
+        dg = gain(P2)[k] - gain(PARAMS)[k]
+        da = add(P2)[k] - add(PARAMS)[k]
+        assert np.all(da[~r] < dg[~r])
