@@ -144,3 +144,14 @@ def test_exudyn_drive_passes_and_its_g_version_is_refused(truck_drive):
         assert r == pytest.approx(1.0, abs=0.1) and c > 0.95, (a, r, c)
     g = check_units({k: (v / G if "acc" in k else v) for k, v in ch.items()}, truck_drive.sample_rate_hz)
     assert sum(f.fatal and "in g" in f.message for f in g) == 4
+
+
+def test_a_scale_error_of_two_is_a_warning_on_every_axle(truck_drive):
+    """Axle accelerations twice too large (a wrong sensitivity, no named unit): with the two
+    sides of each axle averaged the ratio is about 2, above the pair tolerance 1.5 and far
+    from the g and mm windows, so each of the 4 axles gets one warning and none is fatal."""
+    ch = {c: truck_drive.channels[c].to_numpy() for c in truck_drive.channel_names}
+    found = check_units({k: (2 * v if k.startswith("axle_acc") else v) for k, v in ch.items()},
+                        truck_drive.sample_rate_hz)
+    assert sorted(f.column for f in found) == [f"susp_disp_{a}L/R" for a in "1234"]
+    assert not any(f.fatal for f in found) and all("scale error" in f.message for f in found)
