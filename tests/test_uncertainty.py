@@ -44,13 +44,24 @@ def test_gate_flags_misfit_above_the_gate_and_names_segments_with_times():
     assert note.startswith("**POOR FIT**") and "460.0-472.5 s" in note
 
 
-def test_honest_sd_scales_every_component_and_keeps_floors():
+def test_honest_sd_scales_every_component_and_adds_the_model_form_term():
+    """At 4x the reference misfit: sd^2 = (2 KAPPA sd_laplace)^2 + 3 BETA (excess r/R_REF - 1
+    = 3); at or below the reference misfit only KAPPA scales, with no model-form term."""
     lap = {"ln_Gq_n0": 0.1, "w": 0.05, "ln_nmin": 0.3, "ln_nmax": 0.2}
     sd = U.honest_sd(lap, 0.04, objective=4 * U.R_REF * 10, n_features=10)
     for k, v in lap.items():
-        f = 2 * U.KAPPA.get(k, U.KAPPA["ln_Gq_n0"])
-        assert sd[k] == pytest.approx(max(f * v, U.SD_FLOOR.get(k, 0.0)))
-    assert sd["ln_G_n_best"] == pytest.approx(max(2 * U.KAPPA["ln_G_n_best"] * 0.04, U.SD_FLOOR["ln_G_n_best"]))
+        kap = U.KAPPA.get(k, U.KAPPA["ln_Gq_n0"])
+        beta = U.BETA.get(k, U.BETA["ln_Gq_n0"])
+        assert sd[k] == pytest.approx(math.sqrt((2 * kap * v) ** 2 + 3 * beta))
+    assert sd["ln_G_n_best"] == pytest.approx(math.sqrt((2 * U.KAPPA["ln_G_n_best"] * 0.04) ** 2
+                                                        + 3 * U.BETA["ln_G_n_best"]))
+    # the model-form term dominates where the Laplace sd is tiny: a long segment (sd 0.04) whose
+    # misfit is 4x a correct model's must not claim better than sd 0.47 in ln G(n_best), the
+    # spread of the errors on the model-gap drives it was set on (results/inverse_blind)
+    assert sd["ln_G_n_best"] >= 0.47
+    clean = U.honest_sd(lap, 0.04, objective=0.5 * U.R_REF * 10, n_features=10)
+    assert clean["w"] == pytest.approx(U.KAPPA["w"] * 0.05) and clean["ln_G_n_best"] == pytest.approx(
+        U.KAPPA["ln_G_n_best"] * 0.04)
 
 
 def test_table1_shows_intervals_and_gate():
