@@ -39,7 +39,7 @@ RUN_FORMAT = 1
 def register(subparsers) -> None:
     """Add ``eroad invert``."""
     p = subparsers.add_parser(
-        "invert", help="identify the road spectrum of each segment of a drive (issue 5)",
+        "invert", help="identify the road spectrum of each segment of a drive",
         description="Segment a measured drive, fit the ISO 8608 parameters of each segment with the "
                     "nominal Exudyn truck (sampled sensitivities, common random numbers), select the "
                     "road realisation, and write Tables 1-2, Figures 6/8/9 and the global road.")
