@@ -64,6 +64,17 @@ def effects_from_diagnosis(summary: dict) -> tuple[dict | None, str]:
     return params, f"the diagnosis named {verdict} (confidence clear); inverted with {text}"
 
 
+def still_poor_message(fit_quality: dict, effects: dict) -> str:
+    """The gate's one line for a corrected fit that is still poor: the advice to run the
+    diagnosis has been followed, so say what is left instead."""
+    names = ", ".join(effects)
+    segs = ", ".join(str(i) for i in fit_quality.get("poor_segments", []))
+    return (f"segment(s) {segs} exceed the fit-quality gate even with {names} at its calibrated value: "
+            f"what the model still lacks there is not that effect alone (another difference of the "
+            f"vehicle, or a segment the stationary model does not hold); read their numbers with "
+            f"their wide intervals")
+
+
 def compare_table(nominal: list, corrected: list) -> pd.DataFrame:
     """Table 1 nominal beside corrected: per segment of each fit, class, Gq(n0), w, 90 % interval
     of Gq(n0) and the fit-quality gate (the two segmentations may differ; rows are by fit)."""
@@ -131,6 +142,11 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
                                    effects=effects, argv=argv, **inversion)
             main = work / "corrected"
             (work / "nominal").rename(main / "nominal")
+            fq = chosen.get("fit_quality", {})
+            if fq.get("status") == "poor":   # the named effect did not make the model explain it
+                fq["message"] = still_poor_message(fq, effects)
+                from inverse.report import table1, table1_note
+                write_table(table1(chosen["segments"]), main / "tables" / "table1", note=table1_note(fq))
         else:
             chosen, main = nominal, work / "nominal"
         (work / "diagnose").rename(main / "diagnose")

@@ -64,3 +64,12 @@ def test_cli_refuses_auto_with_explicit_effects(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("eroad: error:") and "cannot be combined" in err and "\n" not in err
     assert not (tmp_path / "r").exists()
+
+
+def test_a_corrected_fit_that_stays_poor_says_what_is_left():
+    """After the correction the gate's advice ('run the diagnosis') has been followed: the
+    message names the effect tried and the segments, and no longer sends the user back."""
+    from diagnosis.closed_loop import still_poor_message
+
+    m = still_poor_message({"status": "poor", "poor_segments": [1, 3]}, {"leaf_friction": {"force": 2221.0}})
+    assert "1, 3" in m and "even with leaf_friction" in m and "run the diagnosis" not in m
