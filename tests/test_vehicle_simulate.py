@@ -247,3 +247,19 @@ def test_simulations_release_their_exudyn_systems(road_c):
     assert len(built) >= 3
     for m in built:
         assert m.SC.NumberOfSystems() == 0, "an Exudyn system was not released"
+
+
+def test_lift_off_fraction_uses_static_loads_of_the_static_state():
+    """A smooth 0.5 % grade: the truck climbs 0.2 m in 4 s at 10 m/s and no tyre comes near
+    lifting off (the tyres follow the grade; the dynamic loads stay small). The reported
+    lift-off fraction must be 0. It was 1 before: the static tyre loads were read from the
+    run's LAST state, where the contact points sit 0.2 m above their static height, which
+    turned every static load into a large pull."""
+    from vehicles.params import load_vehicle
+
+    x = np.arange(0.0, 120.0, 0.1)
+    y = np.array([-2.0, 2.0])
+    z = np.repeat((0.005 * x)[:, None], 2, axis=1)
+    res = simulate(load_vehicle("dump_truck_8x4"), RoadSurface(x, y, z), speed=10.0, duration=4.0)
+    assert res.meta["tyre_lift_off_fraction"] == 0.0
+    assert np.max(np.abs(res.extra["tyre_force"])) < 5e3   # about 2 % of an axle's static load

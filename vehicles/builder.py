@@ -483,12 +483,22 @@ class VehicleModel:
         return p + R @ np.asarray(local, float)
 
     def static_tyre_loads(self) -> np.ndarray:
-        """Static vertical tyre forces [N] (positive = pressing on the road), per contact."""
+        """Static vertical tyre forces [N] (positive = pressing on the road), per contact.
+
+        From the static reference (:meth:`record_static_reference`) when it has been
+        recorded, so that the answer after a simulation is still the static one (the current
+        node positions are then those of the run's last step); before that, from the current
+        state (the static solve's).
+        """
         out = []
         for ct in self.contacts:
             ab = self.axles[ct.axle]
-            z = self.point_position(ab.name, ct.local)[2] - (ab.cog[2] + ct.local[2])
-            out.append(-ct.stiffness * z)
+            if ab.name in self.static:
+                p, R = self.static[ab.name]
+                zc = (p + R @ np.asarray(ct.local, float))[2]
+            else:
+                zc = self.point_position(ab.name, ct.local)[2]
+            out.append(-ct.stiffness * (zc - (ab.cog[2] + ct.local[2])))
         return np.array(out)
 
 
