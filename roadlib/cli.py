@@ -31,7 +31,10 @@ SEGMENT_KEYS = {"class", "Gq_n0", "length", "w", "nmin", "nmax", "lambda"}
 
 # ----------------------------------------------------------------------------- helpers
 def _write_text_atomic(path: Path, text: str) -> None:
+    from roadlib.surface import _new_file_mode
+
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.chmod(tmp, _new_file_mode())   # mkstemp's 0600 would stay after the rename
     try:
         with os.fdopen(fd, "w") as fh:
             fh.write(text)

@@ -247,6 +247,7 @@ class RoadSurface:
             raise EroadInputError(f"{path}: metadata is not JSON-serialisable ({exc})") from None
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
         os.close(fd)
+        os.chmod(tmp, _new_file_mode())   # mkstemp's 0600 would stay after the rename
         try:
             if suffix == ".npz":
                 with open(tmp, "wb") as fh:
@@ -349,3 +350,10 @@ def _json_default(o):
     if isinstance(o, Path):
         return str(o)
     raise TypeError(f"{type(o).__name__} is not JSON-serialisable")
+
+
+def _new_file_mode() -> int:
+    """The mode an ordinary new file gets here: 0666 less the process umask."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask

@@ -101,3 +101,21 @@ def test_refusals(tmp_path):
         RoadSurface(np.array([0, 1, 3.0]), np.zeros(1), np.zeros((3, 1)))
     with pytest.raises(EroadInputError, match="not finite at x = 1 m"):
         RoadSurface(np.arange(3.0), np.zeros(1), np.array([[0], [np.nan], [0]]))
+
+
+def test_saved_files_get_ordinary_permissions(tmp_path):
+    """A saved road gets the mode of any new file (0666 less the umask), not mkstemp's 0600,
+    so a colleague can read an archived road (.npz and .crg)."""
+    import os
+    import stat
+
+    mask = os.umask(0o022)
+    try:
+        x = np.arange(0.0, 10.0, 0.1)
+        y = np.array([-1.0, 1.0])
+        road = RoadSurface(x, y, np.zeros((x.size, 2)))
+        for name in ("r.npz", "r.crg"):
+            road.save(tmp_path / name)
+            assert stat.S_IMODE((tmp_path / name).stat().st_mode) == 0o644, name
+    finally:
+        os.umask(mask)
