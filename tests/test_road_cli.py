@@ -150,3 +150,15 @@ def test_bad_toml_and_profiles(tmp_path, capsys):
     assert code == 2 and "--track 9 m is outside the road" in err
     code, _, err = _run(capsys, "road", "generate", "--class", "C", "--out", str(tmp_path / "a.txt"))
     assert code == 2 and "use a .npz or .crg file name" in err
+
+
+def test_gd0_above_class_h_is_refused(tmp_path, capsys):
+    """--gd0 1 (a value in 1e-6 m^3 given as m^3, say) lies above class H's range
+    (H: 0.131-0.524 m^3): one line, exit 2, nothing written; class H's own level passes."""
+    from eroad.cli import main
+
+    out = tmp_path / "r.npz"
+    assert main(["road", "generate", "--gd0", "1", "--length", "20", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "above the range" in err and "\n" not in err and not out.exists()
+    assert main(["road", "generate", "--gd0", "0.262144", "--length", "20", "--out", str(out)]) == 0
