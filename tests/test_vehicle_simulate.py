@@ -188,6 +188,8 @@ def test_cli_simulate_and_effects(tmp_path, capsys):
                  "--out", str(out)])
     assert code == 0
     assert {p.name for p in out.iterdir()} >= {"channels.csv", "meta.toml", "summary.json"}
+    # the count printed is the one `eroad data check` gives: 24 channels, speed apart
+    assert "24 channels + speed" in capsys.readouterr().out
     summary = json.loads((out / "summary.json").read_text())
     for key in ("realtime_factor", "wall_s", "steps"):
         assert key in summary

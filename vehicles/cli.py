@@ -109,7 +109,8 @@ def cmd_simulate(args) -> int:
     else:
         m = res.meta
         print(f"wrote {out}: {m['duration']:g} s of {m['vehicle']} ({m['chassis']}), "
-              f"{len(res.channels)} channels at {m['fs_out']:g} Hz; {m['steps']} steps in "
+              f"{sum(c != 'speed' for c in res.channels)} channels"
+              f"{' + speed' if 'speed' in res.channels else ''} at {m['fs_out']:g} Hz; {m['steps']} steps in "
               f"{m['wall_s']:.2f} s wall ({m['realtime_factor']:.0f}x real time)")
     return 0
 
