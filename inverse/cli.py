@@ -362,8 +362,13 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         (tmp / "config.toml").write_text(tomli_w.dumps(cfg))
         write_json_atomic(tmp / "run.json", {
             "command": list(argv) if argv else ["run_inversion"], "study": "invert",
-            "git": git_state(), "versions": package_versions(), "host": platform.node(),
+            "git": git_state(), "versions": package_versions(),
+            "host": {"hostname": platform.node(), "platform": platform.platform()},
             "started": started.isoformat(), "finished": _dt.datetime.now(_dt.timezone.utc).isoformat(),
+            # the archive's field names (studies.runs), so `eroad runs show` reads this run too
+            "start_utc": started.strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "end_utc": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "seed": seed,
             "status": "complete", "wall_s": timing["total_s"]})
         swap_into_place(tmp, out)   # an old RUN (--force) is removed only once the new one is in place
     except BaseException:

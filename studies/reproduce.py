@@ -230,8 +230,15 @@ def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False
     tmp.mkdir()
     wanted = [name for name, _ in STEPS] if steps is None else list(steps)
     start = time.time()
+    import platform
+    import socket
+
+    stamp = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
+    # the archive's run.json fields (studies.runs) beside this command's own
     record = {"command": sys.argv, "quick": quick, "workers": workers, "git": git_state(),
-              "versions": package_versions(), "start": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+              "versions": package_versions(), "start": stamp, "start_utc": stamp, "end_utc": None,
+              "seed": 0, "host": {"hostname": socket.gethostname(), "platform": platform.platform(),
+                                  "machine": platform.machine(), "cpu_count": os.cpu_count()},
               "status": "running"}
     timings, results = {}, {}
     try:
@@ -250,6 +257,7 @@ def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False
         raise
     finally:
         record["wall_s"] = time.time() - start
+        record["end_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
         record["timings_s"] = timings
         rows = _manifest(tmp)
         write_json_atomic(tmp / "run.json", record)

@@ -134,7 +134,10 @@ def test_partial_reproduce_files_and_manifest(partial_run):
     assert not any(r["present"] for r in others)
     md = (out / "manifest.md").read_text()
     assert md.count("**missing**") == len(manifest) - 2
-    assert json.loads((out / "run.json").read_text())["status"] == "complete"
+    rj = json.loads((out / "run.json").read_text())
+    assert rj["status"] == "complete"
+    # the archive's fields, so `eroad runs show` prints no None for this run
+    assert rj["start_utc"] and rj["end_utc"] and rj["host"]["hostname"] and rj["seed"] is not None
 
 
 def test_recorded_paths_point_into_the_final_folder(partial_run):
