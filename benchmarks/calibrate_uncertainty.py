@@ -71,9 +71,7 @@ def calibrate(rows: list) -> dict:
 
 def reported_sd(r, q, sd_lap, const) -> float:
     """inverse.uncertainty's formula with the constants in ``const``."""
-    x = misfit(r) / const["R_REF"]
-    return float(np.sqrt((const["KAPPA"][q] * sd_lap) ** 2 * max(1.0, x)
-                         + const["BETA"][q] * max(0.0, x - 1.0)))
+    return U.reported_sd(sd_lap, misfit(r), q, kappa=const["KAPPA"], beta=const["BETA"], r_ref=const["R_REF"])
 
 
 def choose_beta(rows: list, const: dict, grid=(0.0, 0.01, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5)) -> dict:

@@ -76,19 +76,19 @@ def still_poor_message(fit_quality: dict, effects: dict) -> str:
 
 
 def compare_table(nominal: list, corrected: list) -> pd.DataFrame:
-    """Table 1 nominal beside corrected: per segment of each fit, class, Gq(n0), w, 90 % interval
-    of Gq(n0) and the fit-quality gate (the two segmentations may differ; rows are by fit)."""
-    rows = []
-    for label, segs in (("nominal", nominal), ("corrected", corrected)):
-        for i, s in enumerate(segs):
-            iv = s.get("interval90", {}).get("Gq_n0")
-            rows.append({"model": label, "segment": i + 1, "t_start_s": round(s["t_start"], 2),
-                         "t_end_s": round(s["t_end"], 2), "class": s["class"],
-                         "Gq_n0_1e-6m3": round(1e6 * s["Gq_n0"], 2), "w": round(s["w"], 3),
-                         "Gq_n0_90pct_1e-6m3": "{:.3g}-{:.3g}".format(*(1e6 * v for v in iv)) if iv else "",
-                         "fit": s.get("fit_quality", {}).get("status", ""),
-                         "misfit_per_feature": round(s.get("fit_quality", {}).get("misfit_per_feature", float("nan")), 2)})
-    return pd.DataFrame(rows)
+    """Table 1 nominal beside corrected (:func:`inverse.report.table1` rows of each fit,
+    labelled by model; the two segmentations may differ, so rows are by fit): segment,
+    times, class, Gq(n0), w, the 90 % interval of Gq(n0) and the fit-quality gate."""
+    from inverse.report import table1
+
+    cols = ["model", "segment", "t_start_s", "t_end_s", "class", "Gq_n0_1e-6m3", "w",
+            "Gq_n0_90pct_1e-6m3", "fit", "misfit_per_feature"]
+    parts = [table1(segs).assign(model=label) for label, segs in (("nominal", nominal), ("corrected", corrected))
+             if segs]
+    if not parts:
+        return pd.DataFrame(columns=cols)
+    df = pd.concat(parts, ignore_index=True)
+    return df[[c for c in cols if c in df.columns]]
 
 
 def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: bool = False,

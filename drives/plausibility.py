@@ -28,11 +28,12 @@ The module knows nothing of vehicles or models; it reads arrays.
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.signal import butter, sosfiltfilt
+
+from drives.format import parse_channel
 
 #: standard gravity [m/s^2]
 G = 9.80665
@@ -58,9 +59,6 @@ UNIT_ERRORS = {
 }
 #: |log10| distance to an identified unit error within which it is named [-]
 UNIT_LOG10_TOL = 0.3
-
-_STATION = re.compile(r"^susp_disp_([1-9][0-9]*)([LR])$")
-
 
 @dataclass(frozen=True)
 class Finding:
@@ -190,9 +188,9 @@ def _stations(channels: dict) -> dict:
     """
     have: dict[str, list[str]] = {}
     for name in channels:
-        m = _STATION.match(name)
-        if m and f"axle_acc_{m.group(1)}{m.group(2)}" in channels:
-            have.setdefault(m.group(1), []).append(m.group(2))
+        p = parse_channel(name)
+        if p and p[0] == "susp_disp" and f"axle_acc_{p[1]}{p[2]}" in channels:
+            have.setdefault(str(p[1]), []).append(p[2])
     out = {}
     for a, sides in sorted(have.items()):
         if len(sides) == 2:

@@ -79,7 +79,7 @@ POOR_FIT_MESSAGE = "the model does not explain these data (misfit {r:.2f} per fe
 def inflation(objective: float, n_features: int, param: str = "ln_Gq_n0") -> float:
     """The factor on the Laplace sd of ``param``: ``KAPPA[param] * sqrt(max(1, r / R_REF))`` [-]."""
     r = objective / max(int(n_features), 1)
-    return KAPPA.get(param, KAPPA["ln_Gq_n0"]) * math.sqrt(max(1.0, r / R_REF))
+    return reported_sd(1.0, r, param, beta={"ln_Gq_n0": 0.0})   # no model-form term
 
 
 def fit_quality(objective: float, n_features: int) -> dict:
@@ -97,8 +97,32 @@ def fit_quality(objective: float, n_features: int) -> dict:
             "message": POOR_FIT_MESSAGE.format(r=r, gate=R_GATE) if poor else ""}
 
 
+def reported_sd(sd_laplace: float, misfit: float, param: str, *, kappa: dict | None = None,
+                beta: dict | None = None, r_ref: float | None = None) -> float:
+    """The reported sd of one quantity (the formula of the module docstring).
+
+    Parameters
+    ----------
+    sd_laplace : float
+        The fit's Laplace sd of ``param`` [ln units or -].
+    misfit : float
+        The segment's misfit per feature, objective / n_features [-].
+    param : str
+        ``ln_Gq_n0``, ``w``, ``ln_G_n_best`` (others take the ``ln_Gq_n0`` factor, and the
+        level's model-form term when they are logarithms).
+    kappa, beta, r_ref : optional
+        Constants other than the module's (``benchmarks/calibrate_uncertainty.py``).
+    """
+    kappa = KAPPA if kappa is None else kappa
+    beta = BETA if beta is None else beta
+    x = misfit / (R_REF if r_ref is None else r_ref)
+    k = kappa.get(param, kappa["ln_Gq_n0"])
+    b = beta.get(param, beta["ln_Gq_n0"] if param.startswith("ln_") else 0.0)
+    return max(math.sqrt((k * sd_laplace) ** 2 * max(1.0, x) + b * max(0.0, x - 1.0)), SD_FLOOR.get(param, 0.0))
+
+
 def honest_sd(sd_laplace: dict, sd_ln_G_n_best: float | None, objective: float, n_features: int) -> dict:
-    """Reported standard deviations of one segment.
+    """Reported standard deviations of one segment (:func:`reported_sd` of each quantity).
 
     Parameters
     ----------
@@ -114,16 +138,10 @@ def honest_sd(sd_laplace: dict, sd_ln_G_n_best: float | None, objective: float, 
     dict
         Same keys as ``sd_laplace`` (scaled) plus ``ln_G_n_best`` when given [ln units or -].
     """
-    excess = max(0.0, objective / max(int(n_features), 1) / R_REF - 1.0)
-
-    def total(k, v):
-        beta = BETA.get(k, BETA["ln_Gq_n0"] if k.startswith("ln_") else 0.0)
-        return max(math.sqrt((inflation(objective, n_features, k) * v) ** 2 + beta * excess),
-                   SD_FLOOR.get(k, 0.0))
-
-    out = {k: total(k, v) for k, v in sd_laplace.items()}
+    r = objective / max(int(n_features), 1)
+    out = {k: reported_sd(v, r, k) for k, v in sd_laplace.items()}
     if sd_ln_G_n_best is not None:
-        out["ln_G_n_best"] = total("ln_G_n_best", sd_ln_G_n_best)
+        out["ln_G_n_best"] = reported_sd(sd_ln_G_n_best, r, "ln_G_n_best")
     return out
 
 

@@ -237,10 +237,6 @@ def cmd_generate(args) -> int:
         if not (math.isfinite(length) and length > 0):
             raise EroadInputError(f"--length must be positive metres, got {length:g}")
         gd0 = class_gd0(args.iso_class) if args.iso_class else args.gd0
-        h_top = 2.0 * class_gd0("H")   # upper bound of ISO 8608's roughest class
-        if gd0 >= h_top:
-            raise EroadInputError(f"--gd0 {gd0:g} m^3 is implausible: above the range of ISO 8608's roughest class H "
-                                  f"(up to {h_top:.3g} m^3); give Gd(n0) in m^3, e.g. 256e-6 for class C")
         params = SpectralParams(Gq_n0=gd0, dx=args.dx, dy=args.dy, **spec)
         surf = synth_surface(params, length, args.width, seed=args.seed)
     if not (math.isfinite(args.width) and args.width >= 0):

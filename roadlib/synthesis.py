@@ -51,7 +51,7 @@ import numpy as np
 import scipy.fft
 
 from eroad.errors import EroadInputError
-from roadlib.psd import ISO_BAND, class_gd0, iso_psd, lateral_density
+from roadlib.psd import ISO_BAND, ISO_CLASSES, class_gd0, iso_psd, lateral_density
 
 #: lateral period of the surface harmonics, as a multiple of the road width
 #: (plus one dy): wide enough that the field does not repeat across the road
@@ -109,10 +109,11 @@ class SpectralParams:
             object.__setattr__(self, name, v)
         if not self.w < 6:
             raise EroadInputError(f"SpectralParams.w = {self.w} is outside (0, 6)")
-        if self.Gq_n0 > 1.0:
+        h_top = ISO_CLASSES["H"].nominal_bounds[1]
+        if self.Gq_n0 >= h_top:
             raise EroadInputError(
-                f"SpectralParams.Gq_n0 = {self.Gq_n0} m^3 is implausible (class H is 0.26e-3 m^3); "
-                "give it in m^3, not 1e-6 m^3")
+                f"SpectralParams.Gq_n0 = {self.Gq_n0:g} m^3 is implausible: above the range of ISO 8608's "
+                f"roughest class H (up to {h_top:.3g} m^3); give Gd(n0) in m^3, e.g. 256e-6 for class C")
         if self.nmin >= self.nmax:
             raise EroadInputError(
                 f"SpectralParams: nmin = {self.nmin} must be below nmax = {self.nmax} cycles/m")
