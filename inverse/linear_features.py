@@ -104,36 +104,19 @@ def band_matrix(features: FeatureSet, nperseg: int) -> np.ndarray:
 
 
 def welch_kernel(fs: float, nperseg: int, oversample: int = 8):
-    """Kernel of the expected Welch estimate with scipy's per-segment mean removal.
-
-    :func:`vehicles.linear.welch_expectation`'s kernel, whose rows for bins 0 and 1
-    are recomputed for the window g_m = w_m e^{-j 2 pi k m / N} - W(k) / N (the mean
-    removed before windowing; for a periodic Hann window W(k) = 0 for k >= 2).
+    """Kernel of the expected Welch estimate with scipy's per-segment mean removal
+    (:func:`vehicles.linear.welch_expectation` with ``detrend=True``).
 
     Returns
     -------
     (fk, ff, K) : bin frequencies [Hz], fine grid [Hz], kernel (n_bins, n_fine) with
         expected Welch PSD = K @ S(ff) for a one-sided PSD S [unit^2/Hz].
     """
-    import scipy.signal
-
     from vehicles.linear import welch_expectation
 
     fk, _, ff, _, K = welch_expectation(lambda f: np.zeros_like(f), fs, nperseg, "hann",
-                                        oversample=oversample, return_kernel=True)
-    K = np.array(K, dtype=float)
-    w = scipy.signal.get_window("hann", int(nperseg))
-    U = fs * np.sum(w ** 2)
-    nfft = int(nperseg) * int(oversample)
-    df = fs / nfft
-    m = np.arange(int(nperseg))
-    mj = np.arange(ff.size)
-    for k in (0, 1):
-        e = np.exp(-2j * np.pi * k * m / nperseg)
-        g = w * e - np.sum(w * e) / nperseg
-        A = np.abs(np.fft.fft(g, nfft)) ** 2
-        K[k] = (A[mj % nfft] + A[(-mj) % nfft]) * df / U
-    return fk, ff, K
+                                        oversample=oversample, return_kernel=True, detrend=True)
+    return fk, ff, np.array(K, dtype=float)
 
 
 def _edge_weights(ff: np.ndarray, lo: float, hi: float) -> np.ndarray:

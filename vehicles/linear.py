@@ -403,7 +403,8 @@ class LinearModel:
 
 # --------------------------------------------------------------------------- helpers
 def welch_expectation(psd, fs: float, nperseg: int, window="hann", oversample: int = 8,
-                      f_max: float | None = None, return_kernel: bool = False) -> tuple:
+                      f_max: float | None = None, return_kernel: bool = False,
+                      detrend: bool = False) -> tuple:
     """Expected Welch estimate of a process with a known one-sided PSD.
 
     ``E[P(f_k)] = (1/U) integral_0^inf S(f) (|W(f_k - f)|^2 + |W(f_k + f)|^2) df`` with
@@ -426,6 +427,11 @@ def welch_expectation(psd, fs: float, nperseg: int, window="hann", oversample: i
     return_kernel : bool
         Also return the fine grid ``ff`` [Hz], the PSD on it and the kernel matrix
         (n_bins, n_fine) with ``expected = kernel @ psd(ff)``.
+    detrend : bool
+        Model scipy's default ``detrend='constant'`` (each segment's mean removed before
+        windowing): the window of bin k becomes g_m = w_m e^{-j 2 pi k m / N} - W(k) / N,
+        which changes the rows of the bins where W(k) != 0 (0 and 1 for a periodic Hann
+        window). Default False: no mean removal.
 
     Returns
     -------
@@ -449,6 +455,15 @@ def welch_expectation(psd, fs: float, nperseg: int, window="hann", oversample: i
     mj = np.arange(ff.size)
     # kernel (n_bins, n_fine): |W(f_k - f_j)|^2 + |W(f_k + f_j)|^2
     Kmat = (Wk[(mk[:, None] - mj[None, :]) % nfft] + Wk[(mk[:, None] + mj[None, :]) % nfft]) * df / U
+    if detrend:
+        m = np.arange(nperseg)
+        for k in range(fk.size):
+            e = np.exp(-2j * np.pi * k * m / nperseg)
+            mean_w = np.sum(w * e) / nperseg
+            if abs(mean_w) < 1e-12 * np.sum(w):
+                continue       # the mean removal leaves this bin's window unchanged
+            A = np.abs(np.fft.fft(w * e - mean_w, nfft)) ** 2
+            Kmat[k] = (A[mj % nfft] + A[(-mj) % nfft]) * df / U
     S = psd(ff)
     if isinstance(S, dict):
         out = {k: Kmat @ np.asarray(v) for k, v in S.items()}
