@@ -20,7 +20,7 @@ def register(subparsers) -> None:
         The top-level subparsers of ``eroad``.
     """
     data = subparsers.add_parser(
-        "data", help="measured datasets: check one, plot Figures 4-5",
+        "data", help="measured datasets: import a logger file, check one, plot Figures 4-5",
         description="Work with measurement datasets (channels.csv + meta.toml; see "
         "docs/measurement.md).")
     dsub = data.add_subparsers(dest="data_command", metavar="ACTION")
@@ -34,6 +34,10 @@ def register(subparsers) -> None:
     chk.add_argument("dataset", metavar="DATASET", help="dataset folder")
     chk.add_argument("--json", action="store_true", help="print the summary (or problems) as JSON")
     chk.set_defaults(func=cmd_check)
+
+    from drives.cli_import import register_import  # eroad data import (logger CSV + map)
+
+    register_import(dsub)
 
     fig = dsub.add_parser(
         "figures", help="Figures 4 and 5: axle-3-left suspension displacement and spectra",
