@@ -36,11 +36,12 @@ The rules (also in ``docs/import.md``)
   ``on_gap = "split"`` (or ``--split-gaps``) writes one dataset per continuous piece,
   ``OUT/part01``, ``OUT/part02``, ..., each with its ``start_time_s``; pieces shorter
   than ``min_part_s`` (default 1 s) are left out and listed in every part's ``[import]``.
-* **Resampling.** Each continuous piece goes onto the uniform grid
-  t_k = t_first + k / rate_hz, k = 0 .. floor((t_last - t_first) rate_hz + 0.01) (grid
-  points up to 1 % of a step past the last sample are included, so a last sample that
-  came slightly early does not cost a grid point; they are extrapolated by the last
-  cubic, over at most 1 % of a step). ``rate_hz`` defaults to 1 / (mean time step of the
+* **Resampling.** One uniform time grid for the whole file, t_k = t_0 + k / rate_hz with
+  t_0 the file's first sample (so a window or a piece after a gap stays on the logger's
+  time base); each continuous piece gets the grid points between its first and last
+  sample, widened by 1 % of a step at both ends (a first or last sample that is slightly
+  off its nominal time does not cost a grid point; those points are extrapolated by the
+  end cubic, over at most 1 % of a step). ``rate_hz`` defaults to 1 / (mean time step of the
   continuous steps), rounded to 4 significant digits. ``method = "cubic"`` (default):
   a not-a-knot cubic spline (:class:`scipy.interpolate.CubicSpline`) through the logger
   samples at their recorded times; ``"linear"``: straight lines. A ``rate_hz`` below
@@ -587,10 +588,11 @@ def resample(t: np.ndarray, x: np.ndarray, grid: np.ndarray, method: str) -> np.
     return CubicSpline(t, x, bc_type="not-a-knot", extrapolate=True)(grid)
 
 
-def uniform_grid(t0: float, t1: float, rate: float) -> np.ndarray:
-    """t0 + k / rate for k = 0 .. floor((t1 - t0) rate + END_SLACK_STEPS)."""
-    n = int(math.floor((t1 - t0) * rate + END_SLACK_STEPS)) + 1
-    return t0 + np.arange(n) / rate
+def uniform_grid(t_ref: float, t0: float, t1: float, rate: float) -> np.ndarray:
+    """The points t_ref + k / rate within [t0, t1], widened by ``END_SLACK_STEPS`` steps."""
+    k0 = int(math.ceil((t0 - t_ref) * rate - END_SLACK_STEPS))
+    k1 = int(math.floor((t1 - t_ref) * rate + END_SLACK_STEPS))
+    return t_ref + np.arange(k0, k1 + 1) / rate
 
 
 # --------------------------------------------------------------------------- the command
@@ -686,6 +688,7 @@ def import_logger(raw, map_path, out, *, window=None, vehicle=None, speed_mps=No
 
     tab = read_raw(raw, m)
     t, rows = tab.time, tab.rows
+    t_ref = float(t[0])   # one time grid for the whole file: windows and pieces stay on it
     sel = np.ones(t.size, bool)
     if m.window[0] is not None:
         sel &= t >= m.window[0]
@@ -720,7 +723,8 @@ def import_logger(raw, map_path, out, *, window=None, vehicle=None, speed_mps=No
     pieces, skipped = [], []
     for a, b in zip(bounds[:-1], bounds[1:]):
         span = t[b - 1] - t[a]
-        if b - a < MIN_SAMPLES or (m.on_gap == "split" and span < m.min_part_s):
+        n_grid = uniform_grid(t_ref, float(t[a]), float(t[b - 1]), rate).size
+        if min(b - a, n_grid) < MIN_SAMPLES or (m.on_gap == "split" and span < m.min_part_s):
             skipped.append({"rows": [int(rows[a]), int(rows[b - 1])],
                             "t_s": [float(t[a]), float(t[b - 1])], "samples": int(b - a)})
             continue
@@ -747,8 +751,9 @@ def import_logger(raw, map_path, out, *, window=None, vehicle=None, speed_mps=No
             "method": m.method,
             "rule": ("not-a-knot cubic spline through the logger samples at their recorded times"
                      if m.method == "cubic" else "linear interpolation between the logger samples")
-                    + ", evaluated on t_first + k / rate_hz, k = 0 .. floor((t_last - t_first) "
-                    f"rate_hz + {END_SLACK_STEPS:g}), per continuous piece",
+                    + ", evaluated on t_0 + k / rate_hz (t_0 the file's first sample) between "
+                    f"each continuous piece's first and last sample +- {END_SLACK_STEPS:g} step",
+            "t0_s": t_ref,
             "rate_hz": rate, "rate_from": "map or command line" if m.rate_hz else
             "1 / mean continuous step, 4 significant digits",
             "gap_rule": f"a step above {m.max_step_factor:g} x the median step is a gap",
@@ -761,7 +766,7 @@ def import_logger(raw, map_path, out, *, window=None, vehicle=None, speed_mps=No
     outputs = []
     for k, (a, b) in enumerate(pieces):
         tp = t[a:b]
-        grid = uniform_grid(float(tp[0]), float(tp[-1]), rate)
+        grid = uniform_grid(t_ref, float(tp[0]), float(tp[-1]), rate)
         frame = {"time": grid}
         conv = {}
         for cm in m.channels:
