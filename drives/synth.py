@@ -9,7 +9,7 @@ reader for estimation code (nothing that estimates may read ``truth/``; use
 :func:`read_truth` only to score).
 
 A scenario is a TOML file (``drives/scenarios/<name>.toml`` for the built-ins
-``luliang``, ``random``, ``null``, or any file with ``--config``).  It may leave
+``luliang``, ``random``, ``null``, ``second``, or any file with ``--config``).  It may leave
 things to the seed (``[speed] kind = "smooth_random"``, ``[road.random]``);
 :func:`resolve_scenario` draws them and returns the *explicit* scenario, which
 is written to ``truth/scenario.toml`` and regenerates the same bytes with
@@ -23,6 +23,14 @@ Seeds (one root seed S; same seed, same bytes)::
                                                segment s uses SeedSequence(R, spawn_key=(s,))
     SeedSequence(S, spawn_key=(3, crc32(c)))   sensor noise of channel c
     SeedSequence(S, spawn_key=(4,)) -> int     simulate(seed=...) (random effects)
+    SeedSequence(S, spawn_key=(5,))            [truth.independent] options given as ranges
+
+Two truth families: ``[truth] model = "exudyn"`` (default; ``vehicles.simulate``) or
+``"independent"`` (``drives.independent_truck``, a separately written lumped model with
+structural differences the Exudyn model lacks; options in ``[truth.independent]``, a
+two-number list ``[lo, hi]`` is drawn uniformly per seed).  ``[road] profile =
+"profile_1"`` drives on a measured longitudinal profile instead of a synthetic road
+(:func:`build_profile_road`).
 
 Segment proportions are TIME proportions: the share of the record during which
 the reference axle (axle 3) runs on the segment.  They become road lengths
@@ -52,9 +60,16 @@ from eroad.errors import EroadInputError
 #: folder of the built-in scenario files
 SCENARIO_DIR = Path(__file__).with_name("scenarios")
 #: built-in scenario names
-SCENARIOS = ("luliang", "random", "null")
+SCENARIOS = ("luliang", "random", "null", "second")
 #: spawn keys of the random streams (see module docstring)
 STREAM_DRAWS, STREAM_SPEED, STREAM_ROAD, STREAM_NOISE, STREAM_VEHICLE = 0, 1, 2, 3, 4
+STREAM_TRUTH_OPTIONS = 5
+#: truth vehicle models ([truth] model)
+TRUTH_MODELS = ("exudyn", "independent")
+#: measured road profiles shipped as package data (drives/data/<name>.txt)
+PROFILE_DIR = Path(__file__).with_name("data")
+#: lateral shift [m] between the two ends of the measured-profile road (build_profile_road)
+PROFILE_SHIFT_M = 40.0
 #: road beyond the vehicle at both ends of the simulated run [m]
 ROAD_MARGIN_M = 10.0
 #: where ``default_dataset`` caches the embedded dataset (env EROAD_CACHE overrides)
@@ -67,10 +82,10 @@ _KEYS = {
     "scenario": {"name", "dataset_name", "description", "vehicle", "duration_s",
                  "sample_rate_hz", "start_time_s", "runin_s", "reference_axle", "seed"},
     "speed": {"kind", "min_mps", "max_mps", "knot_spacing_s", "exact_range", "t_s", "v_mps"},
-    "road": {"dx_m", "dy_m", "width_m", "lam", "segments", "random"},
+    "road": {"dx_m", "dy_m", "width_m", "lam", "segments", "random", "profile"},
     "road.random": {"n_segments", "classes", "w", "nmin", "nmax", "min_segment_s"},
     "road.segments": {"proportion", "Gq_n0", "w", "nmin", "nmax", "lam", "label"},
-    "truth": {"chassis", "frame_segments", "dt_s", "effects"},
+    "truth": {"chassis", "frame_segments", "dt_s", "effects", "model", "independent"},
     "noise": {"susp_disp_m", "axle_acc_mps2", "body_acc_mps2", "dcdc_m", "speed_mps"},
 }
 #: noise key per channel quantity
@@ -295,6 +310,8 @@ def resolve_scenario(cfg: dict, seed: int | None = None, *, effects=(), vehicle=
                               "v_mps be > 0 and of the same length")
 
     road = cfg["road"]
+    if "profile" in road and "segments" not in road:
+        road["segments"] = [_profile_segment(str(road["profile"]), src)]
     if "segments" not in road:
         if "random" not in road:
             raise EroadInputError(f"{src}: [road] needs segments or a [road.random] table")
@@ -323,24 +340,155 @@ def resolve_scenario(cfg: dict, seed: int | None = None, *, effects=(), vehicle=
     tr.setdefault("frame_segments", 0)
     tr.setdefault("dt_s", 0.0)
     eff = dict(tr.get("effects", {})) if default_effects else {}
-    if effects:
+    if tr.get("model", "exudyn") != "exudyn":
+        _resolve_independent(cfg, eff, effects, seed, src)
+    elif "independent" in tr:
+        raise EroadInputError(f"{src}: [truth.independent] needs [truth] model = \"independent\"")
+    elif effects:
         from vehicles.effects import parse_effects
 
         for name, params in parse_effects(list(effects)).items():
             merged = dict(eff.get(name, {}))
             merged.update(params or {})
             eff[name] = merged
-    if eff:
-        from vehicles.effects import resolve_effects
+    if tr.get("model", "exudyn") == "exudyn":
+        if eff:
+            from vehicles.effects import resolve_effects
 
-        eff = {name: dict(params) for name, params in resolve_effects(eff).items()}
-    tr["effects"] = eff
+            eff = {name: dict(params) for name, params in resolve_effects(eff).items()}
+        tr["effects"] = eff
     noise = cfg["noise"]
     for key in _KEYS["noise"]:
         noise.setdefault(key, 0.0)
         if not (isinstance(noise[key], (int, float)) and noise[key] >= 0):
             raise EroadInputError(f"{src}: [noise] {key} must be a number >= 0")
     return cfg
+
+
+def _parse_effect_items(items) -> dict:
+    """``NAME``, ``NAME=VALUE`` (primary parameter), ``NAME.PARAM=VALUE`` -> {name: {param: value}}
+    for the independent model's own effects (``drives.independent_truck.EFFECTS``)."""
+    from drives.independent_truck import EFFECTS
+
+    out: dict = {}
+    for item in items:
+        key, eq, val = str(item).partition("=")
+        name, dot, param = key.strip().partition(".")
+        if name not in EFFECTS:
+            raise EroadInputError(f"effect {name!r} is not available with [truth] model = "
+                                  f"\"independent\" (supported: {', '.join(EFFECTS)})")
+        params = out.setdefault(name, {})
+        if eq:
+            try:
+                value = float(val)
+            except ValueError:
+                raise EroadInputError(f"--effect {item}: {val!r} is not a number") from None
+            params[param if dot else next(iter(EFFECTS[name]))] = value
+    return out
+
+
+def _resolve_independent(cfg: dict, eff: dict, effects, seed: int, src) -> None:
+    """Fill ``[truth]`` of an independent-model scenario: options drawn and checked, effects."""
+    from drives.independent_truck import resolve_effects, resolve_options
+
+    tr = cfg["truth"]
+    if tr["model"] not in TRUTH_MODELS:
+        raise EroadInputError(f"{src}: [truth] model = {tr['model']!r}: use one of "
+                              f"{', '.join(TRUTH_MODELS)}")
+    if tr["chassis"] != "nominal" or int(tr["frame_segments"]) != 0 or float(tr["dt_s"]) != 0:
+        raise EroadInputError(f"{src}: [truth] chassis, frame_segments and dt_s are Exudyn options; "
+                              "the independent model takes its step from [truth.independent] dt_s")
+    opts = dict(tr.get("independent", {}))
+    rng = _rng(seed, STREAM_TRUTH_OPTIONS)
+    for key in sorted(opts):            # a [lo, hi] range is drawn per seed (sorted: stable order)
+        v = opts[key]
+        if isinstance(v, list):
+            if len(v) != 2 or not all(isinstance(x, (int, float)) for x in v) or v[0] > v[1]:
+                raise EroadInputError(f"{src}: [truth.independent] {key} must be a number or [lo, hi]")
+            opts[key] = float(rng.uniform(float(v[0]), float(v[1])))
+    tr["independent"] = resolve_options(opts, src=f"{src}: [truth.independent]")
+    for name, params in _parse_effect_items(effects).items():
+        merged = dict(eff.get(name, {}))
+        merged.update(params)
+        eff[name] = merged
+    tr["effects"] = resolve_effects(eff)
+
+
+def _profile_file(name: str, src) -> Path:
+    p = PROFILE_DIR / f"{name}.txt"
+    if not (re.fullmatch(r"[A-Za-z0-9_]+", name) and p.is_file()):
+        known = sorted(f.stem for f in PROFILE_DIR.glob("*.txt"))
+        raise EroadInputError(f"{src}: [road] profile = {name!r}: unknown (known: {', '.join(known)})")
+    return p
+
+
+def read_profile(name: str, src="profile") -> tuple[np.ndarray, np.ndarray]:
+    """A measured longitudinal profile: chainage from 0 [m] and detrended height [m].
+
+    The straight line fitted by least squares (grade and level) is removed.
+    """
+    data = np.loadtxt(_profile_file(name, src))
+    x = data[:, 0] - data[0, 0]
+    z = data[:, 1] - np.polyval(np.polyfit(x, data[:, 1], 1), x)
+    return x, z
+
+
+def _profile_segment(name: str, src) -> dict:
+    """One road segment describing a measured profile: an ISO 8608 fit of its PSD.
+
+    Gq(n0) and w from a least-squares line through log Welch PSD (0.05-2 cycles/m,
+    one-sided, displacement PSD in m^3) -- descriptive truth for scoring only.
+    """
+    from scipy.signal import welch
+
+    from roadlib.psd import class_of
+
+    x, z = read_profile(name, src)
+    dx = float(np.mean(np.diff(x)))
+    n, g = welch(z, fs=1.0 / dx, nperseg=512, detrend="linear")
+    sel = (n >= 0.05) & (n <= 2.0)
+    slope, icpt = np.polyfit(np.log10(n[sel] / 0.1), np.log10(g[sel]), 1)
+    gq = float(10 ** icpt)
+    return {"proportion": 1.0, "Gq_n0": gq, "w": float(-slope), "nmin": 0.05, "nmax": 2.0,
+            "label": class_of(gq)}
+
+
+def build_profile_road(cfg: dict, plan: dict):
+    """The road of a measured profile (``[road] profile``).
+
+    Both wheel tracks come from the one detrended profile p(x): z(x, y) =
+    a(y) p(x) + (1 - a(y)) p(x + PROFILE_SHIFT_M), a(y) running linearly from 1 at
+    the left road edge to 0 at the right one, so the two tracks are different
+    mixes of the same measured profile (partly coherent, as real left/right tracks;
+    left track at y = +0.93 m is 0.81 p(x) + 0.19 p(x + 40 m) on a 3 m road).
+
+    Raises
+    ------
+    EroadInputError
+        The drive needs more road than the profile has.
+    """
+    from roadlib.surface import RoadSurface
+
+    road = cfg["road"]
+    name = str(road["profile"])
+    xp, zp = read_profile(name, "[road] profile")
+    dx, dy, width = float(road["dx_m"]), float(road["dy_m"]), float(road["width_m"])
+    length = float(plan["road_length"])
+    if length + PROFILE_SHIFT_M > xp[-1]:
+        raise EroadInputError(f"[road] profile = {name!r}: the drive needs {length:.0f} m of road "
+                              f"(+{PROFILE_SHIFT_M:g} m lateral-mix shift) but the profile has "
+                              f"{xp[-1]:.0f} m; shorten duration_s or lower the speed")
+    x = np.arange(int(round(length / dx)) + 1) * dx
+    ny = int(round(width / dy)) + 1 if width > 0 else 1
+    y = (np.arange(ny) - (ny - 1) / 2) * dy
+    a = 0.5 + y / width if width > 0 else np.ones(1)
+    p0 = np.interp(x, xp, zp)
+    p1 = np.interp(x + PROFILE_SHIFT_M, xp, zp)
+    z = a[None, :] * p0[:, None] + (1 - a[None, :]) * p1[:, None]
+    meta = {"generator": "drives.synth.build_profile_road", "profile": name,
+            "shift_m": PROFILE_SHIFT_M, "segments": [{"start": 0.0, "end": float(x[-1])}],
+            "junctions": []}
+    return RoadSurface(x, y, z, meta)
 
 
 # --------------------------------------------------------------------------- the drive
@@ -415,6 +563,8 @@ def build_road(cfg: dict, plan: dict):
     from roadlib.segments import RoadSegment, segmented_surface
 
     road = cfg["road"]
+    if "profile" in road:
+        return build_profile_road(cfg, plan)
     segs = [RoadSegment(Gq_n0=float(s["Gq_n0"]), share=float(length), w=float(s["w"]),
                         nmin=float(s["nmin"]), nmax=float(s["nmax"]),
                         lam=float(s.get("lam", road["lam"])), label=str(s.get("label", "")))
@@ -459,6 +609,9 @@ def add_noise(frame: pd.DataFrame, noise: dict, seed: int) -> pd.DataFrame:
 
 def _sim_kwargs(cfg: dict) -> dict:
     tr = cfg["truth"]
+    if tr.get("model", "exudyn") == "independent":
+        return {"model": "independent", "options": dict(tr["independent"]),
+                "effects": {k: dict(v) for k, v in tr["effects"].items()}}
     kw = {"effects": {k: dict(v) for k, v in tr["effects"].items()}}
     if tr["chassis"] != "nominal":
         kw["chassis"] = tr["chassis"]
@@ -508,25 +661,38 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
     dict
         Summary (also ``truth/summary.json`` without the wall time).
     """
-    from vehicles.params import load_vehicle
-    from vehicles.simulate import SpeedProfile, simulate
-
     t_wall = time.perf_counter()
     out = Path(out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())) and not force:
         raise EroadInputError(f"{out}: exists and is not empty; choose another --out or use --force")
     sc = cfg["scenario"]
     seed = int(sc["seed"])
-    vp = load_vehicle(sc["vehicle"])
-    axle_x = [float(a.x) for a in vp.axles]
+    independent = cfg["truth"].get("model", "exudyn") == "independent"
+    if independent:
+        from drives.independent_truck import build_truck, read_vehicle_toml, simulate_independent
+
+        axle_x = [float(a["x"]) for a in read_vehicle_toml(sc["vehicle"])["axle"]]
+    else:
+        from vehicles.params import load_vehicle
+        from vehicles.simulate import SpeedProfile, simulate
+
+        vp = load_vehicle(sc["vehicle"])
+        axle_x = [float(a.x) for a in vp.axles]
     plan = plan_drive(cfg, axle_x)
     road = build_road(cfg, plan)
     fs = float(sc["sample_rate_hz"])
     n_rec, n_run = plan["n_record"], plan["n_runin"]
     duration_sim = (n_run + n_rec) / fs
-    res = simulate(vp, road, speed=SpeedProfile(plan["t_sim"], plan["v_sim"]),
-                   duration=duration_sim, fs_out=fs, x_start=plan["x_front0"], y_offset=0.0,
-                   seed=_int_seed(seed, STREAM_VEHICLE), **_sim_kwargs(cfg))
+    if independent:
+        model = build_truck(sc["vehicle"], options=cfg["truth"]["independent"],
+                            effects=cfg["truth"]["effects"])
+        res = simulate_independent(model, road, t_speed=plan["t_sim"], v_speed=plan["v_sim"],
+                                   duration=duration_sim, fs_out=fs, x_start=plan["x_front0"],
+                                   y_offset=0.0)
+    else:
+        res = simulate(vp, road, speed=SpeedProfile(plan["t_sim"], plan["v_sim"]),
+                       duration=duration_sim, fs_out=fs, x_start=plan["x_front0"], y_offset=0.0,
+                       seed=_int_seed(seed, STREAM_VEHICLE), **_sim_kwargs(cfg))
     tsim = np.asarray(res.time, float)
     idx = np.searchsorted(tsim, n_run / fs - 0.25 / fs)
     if tsim.size - idx < n_rec:
