@@ -56,9 +56,10 @@ The rules (also in ``docs/import.md``)
   f / fs = 0.05 (10 Hz at 200 Hz), 4e-7 and 5e-5. Linear interpolation cannot meet a
   1e-6 target on signals with content at a tenth of the sample rate; cubic can.
   (Measured in ``tests/test_data_import.py``: ``test_jitter_against_exact_signal``.)
-* **Window.** ``[window] start_s / end_s`` (or ``--window``) keeps the samples with
-  start_s <= t <= end_s, in the logger's time after unit conversion, before the gap
-  check and the resampling.
+* **Window.** ``[window] start_s / end_s`` (or ``--window``) keeps the grid points with
+  start_s <= t <= end_s (the logger's time in seconds); the interpolation still uses up to
+  20 samples beyond each end (``MARGIN_SAMPLES``), so the window's edges are as accurate
+  as its middle. Only gaps that overlap the window count.
 * **Refused, nothing written** (one line: file, column, row): an empty file, a header
   without rows, a mapped column missing from the header, a cell that is not a number
   (empty, text, NaN, infinite), a ragged row, a blank row inside the data, time not
@@ -107,6 +108,9 @@ MAX_STEP_FACTOR = 1.5
 MIN_PART_S = 1.0
 #: grid points up to this fraction of a step past the last sample are kept [-]
 END_SLACK_STEPS = 0.01
+#: samples beyond a window's ends that the interpolation still uses (a cubic spline's
+#: dependence on a sample decays by 2 - sqrt(3) = 0.27 per sample: 0.27^20 = 4e-12)
+MARGIN_SAMPLES = 20
 #: fewest samples of a piece (a not-a-knot cubic needs 4)
 MIN_SAMPLES = 4
 #: rows converted per chunk (bounds the memory of the text cells)
@@ -687,30 +691,11 @@ def import_logger(raw, map_path, out, *, window=None, vehicle=None, speed_mps=No
     ds["vehicle"] = veh_meta
 
     tab = read_raw(raw, m)
-    t, rows = tab.time, tab.rows
+    t, rows, vals = tab.time, tab.rows, tab.values
     t_ref = float(t[0])   # one time grid for the whole file: windows and pieces stay on it
-    sel = np.ones(t.size, bool)
-    if m.window[0] is not None:
-        sel &= t >= m.window[0]
-    if m.window[1] is not None:
-        sel &= t <= m.window[1]
-    if np.count_nonzero(sel) < MIN_SAMPLES:
-        w = [("start" if v is None else f"{v:g}") for v in m.window]
-        raise EroadInputError(f"{raw}, column '{m.time.column}': window [{w[0]}, {w[1]}] s holds "
-                              f"{np.count_nonzero(sel)} sample(s), fewer than {MIN_SAMPLES} "
-                              f"(the file spans {t[0]:.9g} to {t[-1]:.9g} s)")
-    t, rows = t[sel], rows[sel]
-    vals = {k: v[sel] for k, v in tab.values.items()}
+    ws = -math.inf if m.window[0] is None else m.window[0]
+    we = math.inf if m.window[1] is None else m.window[1]
     gaps, med = find_gaps(t, m.max_step_factor)
-    if gaps.size and m.on_gap == "refuse":
-        i = int(gaps[0])
-        step = t[i + 1] - t[i]
-        raise EroadInputError(
-            f"{raw}, column '{m.time.column}', row {int(rows[i + 1])}: gap in time: step "
-            f"{step:.6g} s from t = {t[i]:.9g} s to {t[i + 1]:.9g} s is {step / med:.3g} median "
-            f"steps ({med:.6g} s), above the limit of {m.max_step_factor:g} ({gaps.size} gap(s)); "
-            "set [resample] on_gap = \"split\" in the map (or --split-gaps) to write one "
-            "dataset per continuous piece, or cut it out with --window")
     data_rate = default_rate(t, gaps)
     rate = m.rate_hz or data_rate
     if rate < 0.99 * data_rate:
@@ -719,24 +704,47 @@ def import_logger(raw, map_path, out, *, window=None, vehicle=None, speed_mps=No
             f"({data_rate:g} Hz); resampling down without a low-pass filter would alias the "
             f"content between {rate / 2:g} and {data_rate / 2:g} Hz into the record; import at the "
             "logger's rate (leave rate_hz out)")
+    # gaps that matter: those overlapping the window
+    gaps_in = np.array([i for i in gaps if t[i + 1] > ws and t[i] < we], dtype=int)
+    if gaps_in.size and m.on_gap == "refuse":
+        i = int(gaps_in[0])
+        step = t[i + 1] - t[i]
+        raise EroadInputError(
+            f"{raw}, column '{m.time.column}', row {int(rows[i + 1])}: gap in time: step "
+            f"{step:.6g} s from t = {t[i]:.9g} s to {t[i + 1]:.9g} s is {step / med:.3g} median "
+            f"steps ({med:.6g} s), above the limit of {m.max_step_factor:g} ({gaps_in.size} "
+            "gap(s)); set [resample] on_gap = \"split\" in the map (or --split-gaps) to write "
+            "one dataset per continuous piece, or leave it out with --window")
     bounds = np.concatenate([[0], gaps + 1, [t.size]])
+    tol = 1e-9 / rate
     pieces, skipped = [], []
     for a, b in zip(bounds[:-1], bounds[1:]):
-        span = t[b - 1] - t[a]
-        n_grid = uniform_grid(t_ref, float(t[a]), float(t[b - 1]), rate).size
-        if min(b - a, n_grid) < MIN_SAMPLES or (m.on_gap == "split" and span < m.min_part_s):
+        grid = uniform_grid(t_ref, float(t[a]), float(t[b - 1]), rate)
+        grid = grid[(grid >= ws - tol) & (grid <= we + tol)]
+        if grid.size == 0:
+            continue                      # the piece lies outside the window
+        span = grid[-1] - grid[0]
+        if min(b - a, grid.size) < MIN_SAMPLES or (m.on_gap == "split" and span < m.min_part_s):
             skipped.append({"rows": [int(rows[a]), int(rows[b - 1])],
-                            "t_s": [float(t[a]), float(t[b - 1])], "samples": int(b - a)})
+                            "t_s": [float(grid[0]), float(grid[-1])], "samples": int(grid.size)})
             continue
-        pieces.append((a, b))
+        # the samples the interpolation uses: the piece within the window +- MARGIN samples
+        lo = max(a, int(np.searchsorted(t, grid[0], "left")) - MARGIN_SAMPLES)
+        hi = min(b, int(np.searchsorted(t, grid[-1], "right")) + MARGIN_SAMPLES)
+        pieces.append((lo, hi, grid))
     if not pieces:
-        raise EroadInputError(f"{raw}: no continuous piece of at least {m.min_part_s:g} s and "
-                              f"{MIN_SAMPLES} samples between the gaps ({gaps.size} gap(s))")
+        w = [("start" if v is None else f"{v:g}") for v in m.window]
+        raise EroadInputError(
+            f"{raw}, column '{m.time.column}': no continuous piece of at least "
+            f"{MIN_SAMPLES} samples{f' and {m.min_part_s:g} s' if m.on_gap == 'split' else ''} "
+            f"in the window [{w[0]}, {w[1]}] s (the file spans {t[0]:.9g} to {t[-1]:.9g} s, "
+            f"{gaps.size} gap(s))")
 
     d = np.diff(t)
-    stats = {"median_step_s": med, "mean_step_s": float(np.mean(np.delete(d, gaps))),
+    cont = np.delete(d, gaps)
+    stats = {"median_step_s": med, "mean_step_s": float(np.mean(cont)),
              "min_step_s": float(d.min()), "max_step_s": float(d.max()),
-             "max_rel_jitter": float(np.max(np.abs(np.delete(d, gaps) - med)) / med)}
+             "max_rel_jitter": float(np.max(np.abs(cont - med)) / med) if cont.size else 0.0}
     record = {
         "tool": "eroad data import",
         "source": str(raw), "source_sha256": _sha256(raw),
@@ -746,27 +754,30 @@ def import_logger(raw, map_path, out, *, window=None, vehicle=None, speed_mps=No
         "ignored_columns": [c for c in tab.header
                             if c not in {m.time.column, *(cm.column for cm in m.channels)}],
         "time": {"column": m.time.column, "unit": m.time.unit, "factor": m.time.factor},
-        "window_s": {k: v for k, v in zip(("start", "end"), m.window) if v is not None},
+        **({"window_s": {k: v for k, v in zip(("start", "end"), m.window) if v is not None}}
+           if any(v is not None for v in m.window) else {}),
         "resampling": {
             "method": m.method,
             "rule": ("not-a-knot cubic spline through the logger samples at their recorded times"
                      if m.method == "cubic" else "linear interpolation between the logger samples")
                     + ", evaluated on t_0 + k / rate_hz (t_0 the file's first sample) between "
-                    f"each continuous piece's first and last sample +- {END_SLACK_STEPS:g} step",
+                    f"each continuous piece's first and last sample +- {END_SLACK_STEPS:g} step, "
+                    f"within the window; the samples used reach {MARGIN_SAMPLES} beyond the "
+                    "window where the piece has them",
             "t0_s": t_ref,
             "rate_hz": rate, "rate_from": "map or command line" if m.rate_hz else
             "1 / mean continuous step, 4 significant digits",
             "gap_rule": f"a step above {m.max_step_factor:g} x the median step is a gap",
             "max_step_factor": m.max_step_factor, "on_gap": m.on_gap,
             "gaps": [{"row": int(rows[i + 1]), "from_s": float(t[i]), "to_s": float(t[i + 1])}
-                     for i in gaps],
+                     for i in gaps_in],
+            "gaps_outside_window": int(gaps.size - gaps_in.size),
             "skipped_pieces": skipped, **stats,
         },
     }
     outputs = []
-    for k, (a, b) in enumerate(pieces):
+    for k, (a, b, grid) in enumerate(pieces):
         tp = t[a:b]
-        grid = uniform_grid(t_ref, float(tp[0]), float(tp[-1]), rate)
         frame = {"time": grid}
         conv = {}
         for cm in m.channels:
@@ -804,8 +815,9 @@ def import_logger(raw, map_path, out, *, window=None, vehicle=None, speed_mps=No
         meta.setdefault("description", f"imported from {raw.name} by eroad data import")
         rec = dict(record, columns=conv,
                    piece={"part": k + 1, "parts": len(pieces),
-                          "source_rows": [int(rows[a]), int(rows[b - 1])],
-                          "source_t_s": [float(tp[0]), float(tp[-1])], "samples_in": int(b - a),
+                          "source_rows_used": [int(rows[a]), int(rows[b - 1])],
+                          "source_t_s_used": [float(tp[0]), float(tp[-1])],
+                          "samples_in": int(b - a),
                           "samples_out": int(grid.size)})
         outputs.append((df, meta, rec))
 

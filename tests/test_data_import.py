@@ -320,11 +320,22 @@ def test_split_leaves_out_short_pieces(original, tmp_path):
 
 
 def test_window(original, tmp_path):
-    raw = write_logger(logger_frame(original), tmp_path / "logger.csv")
+    """The window keeps the grid points in [461, 463] s; the interpolation uses samples beyond
+    its ends, so its edges match the original within 1e-6 like its middle; a gap outside the
+    window does not matter."""
+    raw = write_logger(_with_gap(original, start=1000), tmp_path / "logger.csv")
     import_logger(raw, write_map(tmp_path / "map.toml"), tmp_path / "imp", window=(461.0, 463.0))
     d = read_drive(tmp_path / "imp")
-    assert d.time[0] == pytest.approx(461.0, abs=0.01) and d.time[-1] <= 463.0
-    assert d.time[0] >= 461.0 - 1e-12
+    assert d.time[0] == 461.0 and d.time[-1] == pytest.approx(463.0) and d.n_samples == 401
+    assert d.meta["start_time_s"] == 461.0
+    err = rel_errors(original.window(461.0, 463.001), d)
+    assert max(err.values()) < 1e-6, err
+    with pytest.raises(EroadInputError, match="no continuous piece .* in the window \\[470, 480\\]"):
+        import_logger(raw, write_map(tmp_path / "map.toml"), tmp_path / "imp2",
+                      window=(470.0, 480.0))
+    with pytest.raises(EroadInputError, match="row 1002: gap in time"):
+        import_logger(raw, write_map(tmp_path / "map.toml"), tmp_path / "imp3",
+                      window=(461.0, 466.0))
 
 
 # --------------------------------------------------------------------------- refusals
