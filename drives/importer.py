@@ -70,6 +70,7 @@ from __future__ import annotations
 
 import csv
 import hashlib
+import re
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -829,7 +830,23 @@ def import_logger(raw, map_path, out, *, window=None, vehicle=None, speed_mps=No
             doc["import"] = rec
             (tmp / META_FILE).write_text(tomli_w.dumps(doc), encoding="utf-8")
 
-        write_drive(folder, df, meta, vehicle_file=veh_file, add_files=add)
+        try:
+            write_drive(folder, df, meta, vehicle_file=veh_file, add_files=add)
+        except EroadInputError as exc:
+            # the contract check speaks of the dataset's columns; name the map's entries too
+            msg = str(exc)
+            st = re.search(r"at station (\d+)", msg)
+            if st:   # the kinematic unit check: every channel of that axle is concerned
+                named = [cm for cm in m.channels if cm.name != "speed"
+                         and str(parse_channel(cm.name)[1]) == st.group(1)]
+            else:
+                col = re.search(r"column '([^']+)'", msg)
+                named = [cm for cm in m.channels if col and cm.name == col.group(1)]
+            if named:
+                msg += "; in the map " + m.path.name + ": " + ", ".join(
+                    f"{cm.name} = column '{cm.column}' in '{cm.unit}'" for cm in named) + \
+                    " (the values are written as unit x factor; is the unit right?)"
+            raise EroadInputError(msg) from None
 
     written = []
     if m.on_gap == "split":

@@ -517,3 +517,18 @@ def test_cli(original, tmp_path, capsys):
     assert main(["data", "import", str(gappy), "--map", str(mp), "--out", str(tmp_path / "c"),
                  "--split-gaps", "--json"]) == 0
     assert '"datasets"' in capsys.readouterr().out
+
+
+def test_wrong_unit_in_map_refused_by_the_contract_naming_the_map(original, tmp_path):
+    """A map that says m where the logger wrote mm: the contract's range check refuses it,
+    and the message names the map entry to fix."""
+    raw = write_logger(logger_frame(original), tmp_path / "logger.csv")
+    mp = write_map(tmp_path / "map.toml")
+    mp.write_text(mp.read_text().replace('"Weg_HA3_li", unit = "mm"', '"Weg_HA3_li", unit = "m"'))
+    with pytest.raises(EroadInputError) as ei:
+        import_logger(raw, mp, tmp_path / "imp")
+    msg = str(ei.value)
+    assert msg.startswith("not written:") and "looks like millimetres" in msg
+    assert "in the map map.toml: susp_disp_3L = column 'Weg_HA3_li' in 'm'" in msg
+    assert not (tmp_path / "imp").exists()
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
