@@ -158,6 +158,37 @@ class Effect:
             out[p.name] = p.check(values.get(p.name, p.default), self.name)
         return out
 
+    def vehicle_ranges(self, vp) -> dict:
+        """Allowed range of every parameter on vehicle ``vp``.
+
+        The ``range`` of a :class:`Parameter` is the same for every vehicle; an effect
+        whose physical limits depend on the vehicle (payload: the payload can not be
+        taken below zero) narrows it here.
+
+        Returns
+        -------
+        dict
+            ``{name: (lo, hi, why)}``; ``why`` says where a vehicle-specific limit
+            comes from ("" for the plain parameter range).
+        """
+        return {p.name: (float(p.range[0]), float(p.range[1]), "") for p in self.parameters}
+
+    def check_vehicle(self, vp, p: dict) -> None:
+        """Refuse values outside :meth:`vehicle_ranges` on vehicle ``vp``.
+
+        Raises
+        ------
+        EroadInputError
+            One line naming the value, the vehicle and its allowed range.
+        """
+        for name, (lo, hi, why) in self.vehicle_ranges(vp).items():
+            v = p[name]
+            if not lo <= v <= hi:
+                unit = self.parameter(name).unit
+                raise EroadInputError(
+                    f"effect {self.name}: {name} = {v:g} {unit} is outside the range for vehicle "
+                    f"{vp.id}: [{lo:g}, {hi:g}] {unit}" + (f" ({why})" if why else ""))
+
     def to_dict(self) -> dict:
         """JSON description (``eroad effects --json``)."""
         return {"name": self.name, "description": self.description, "primary": self.primary,
