@@ -485,6 +485,9 @@ def build_truck(vehicle="dump_truck_8x4", options: dict | None = None,
               "weight": float(-fg.sum()), "sprung_weight": float((M[0, 0] + (M[6, 6] if cab_on else 0.0)) * G),
               "cab_weight": float(M[6, 6] * G) if cab_on else 0.0,
               "axle_loads": np.array([F_tyre_static[np.array(t_axle) == i].sum() / G for i in range(na)])}
+    # channel order of the project's datasets: quantity, then axle, then side
+    order = {"susp_disp": 0, "axle_acc": 1, "body_acc": 2}
+    outputs = dict(sorted(outputs.items(), key=lambda kv: (order[kv[0][:-3]], kv[0][-2:])))
     static_offset = np.array([offset.get(ch, 0.0) for ch in outputs])
     return TruckModel(n=n, M=M, K=K_dyn, C=C, bodies=dict(A.bodies), tyres=tyres, friction=friction,
                       outputs=outputs, static_offset=static_offset, static=static, options=opt,
@@ -603,8 +606,10 @@ def simulate_independent(model: TruckModel, road, *, t_speed, v_speed, duration:
         return a
 
     out_q = np.empty((n_out, n))
+    out_v = np.empty((n_out, n))
     out_a = np.empty((n_out, n))
     out_q[0] = q
+    out_v[0] = v
     out_a[0] = accel(q, v, 0)
     half = dt / 2
     k = 0
@@ -626,6 +631,7 @@ def simulate_independent(model: TruckModel, road, *, t_speed, v_speed, duration:
         if (step + 1) % sub == 0:
             j = (step + 1) // sub
             out_q[j] = q
+            out_v[j] = v
             out_a[j] = accel(q, v, k)
             if not np.all(np.isfinite(q)):
                 from eroad.errors import SimulationError
@@ -634,6 +640,7 @@ def simulate_independent(model: TruckModel, road, *, t_speed, v_speed, duration:
     t_out = np.arange(n_out) / fs_out
     ko = np.arange(n_out) * 2 * sub
     defl = d0[None, :] + zr[ko] - out_q @ Gt.T
+    tyre_force = _tyre_force(defl, vr[ko] - out_v @ Gt.T, kt, ct, p, dref, liftoff)
     lift_frac = float(np.mean(np.any(defl < 0, axis=1)))
     channels = {}
     for (ch, (kind, g)), off in zip(model.outputs.items(), model.static_offset):
@@ -647,7 +654,8 @@ def simulate_independent(model: TruckModel, road, *, t_speed, v_speed, duration:
             "axle_loads_t": [float(x) / 1000 for x in model.static["axle_loads"]],
             "wall_s": time.perf_counter() - t_wall}
     return IndependentResult(time=t_out, channels=channels, meta=meta,
-                             extra={"road_z": zr[ko], "q": out_q})
+                             extra={"road_z": zr[ko], "q": out_q, "tyre_force": tyre_force,
+                                    "contact_y": y_offset + tyr["y"], "contact_x": tyr["x"]})
 
 
 def _tyre_force(d, dv, kt, ct, p, dref, liftoff):
