@@ -1,4 +1,5 @@
-"""Command line of the vehicles package: ``eroad simulate`` and ``eroad effects``.
+"""Command line of the vehicles package: ``eroad simulate``, ``eroad effects`` and
+``eroad vehicle new|check``.
 
 What it is for: running one simulation from files (vehicle, road, speed) into a
 dataset folder in the measurement format plus ``summary.json``, and listing the
@@ -15,7 +16,7 @@ from eroad.errors import EroadInputError
 
 
 def register(subparsers) -> None:
-    """Add ``simulate`` and ``effects`` to the CLI."""
+    """Add ``simulate``, ``effects`` and ``vehicle`` to the CLI."""
     p = subparsers.add_parser(
         "simulate", help="drive a vehicle model over a road file and write a dataset",
         description="Simulate a vehicle (rigid or flexible chassis, optional effects) over a "
@@ -49,6 +50,34 @@ def register(subparsers) -> None:
                               "default and sensible range, and what each does physically.")
     e.add_argument("--json", action="store_true", help="machine-readable list")
     e.set_defaults(func=cmd_effects)
+
+    v = subparsers.add_parser(
+        "vehicle", help="your own vehicle: copy a built-in one, check a vehicle file",
+        description="Make your own vehicle file from a built-in one (every field commented "
+        "with unit and meaning) and check a vehicle file against heavy-truck ranges.")
+    vsub = v.add_subparsers(dest="vehicle_command", metavar="ACTION")
+    v.set_defaults(func=lambda a: (v.print_help(), 2)[1])
+    vn = vsub.add_parser(
+        "new", help="write a commented copy of a built-in vehicle to edit",
+        description="Write a commented copy of a vehicle (built-in id or file) to OUT; the "
+        "copy's id is OUT's name. Refuses to overwrite an existing file.",
+        epilog="Example: eroad vehicle new --from dump_truck_8x4 --out my_truck.toml")
+    vn.add_argument("--from", dest="source", required=True, metavar="VEHICLE",
+                    help="built-in id (dump_truck_8x4, e_tractor) or a vehicle .toml file")
+    vn.add_argument("--out", required=True, metavar="FILE.toml", help="new file to write")
+    vn.set_defaults(func=cmd_vehicle_new)
+    vc = vsub.add_parser(
+        "check", help="static deflections, natural frequencies, damping vs heavy-truck ranges",
+        description="Load a vehicle (the loader refuses missing or non-positive fields), then "
+        "compute per axle the static loads and spring and tyre deflections, the quarter-car "
+        "body bounce and axle hop frequencies and the damping ratios, and compare them with "
+        "heavy-truck ranges (body bounce 1-3 Hz, axle hop 8-15 Hz, suspension damping ratio "
+        "0.1-0.5 (leaf springs 0.05-0.5), spring deflection 20-250 mm, tyre deflection "
+        "10-60 mm). Warnings name the numbers; the exit code is 0 with warnings, 2 if the "
+        "file does not load.")
+    vc.add_argument("vehicle", metavar="VEHICLE", help="vehicle .toml file or built-in id")
+    vc.add_argument("--json", action="store_true", help="print the full report as JSON")
+    vc.set_defaults(func=cmd_vehicle_check)
 
 
 
@@ -129,4 +158,27 @@ def cmd_effects(args) -> int:
         for p in e["parameters"]:
             lo, hi = p["range"]
             print(f"    - {p['name']} [{p['unit']}] default {p['default']:g}, range {lo:g}..{hi:g}: {p['doc']}")
+    return 0
+
+
+def cmd_vehicle_new(args) -> int:
+    """Run ``eroad vehicle new``; returns the exit code."""
+    from vehicles.check import new_vehicle_file
+
+    out = new_vehicle_file(args.source, args.out)
+    print(f"wrote {out}: a commented copy of {args.source}; edit it, then run "
+          f"'eroad vehicle check {out}'")
+    return 0
+
+
+def cmd_vehicle_check(args) -> int:
+    """Run ``eroad vehicle check``; returns the exit code (0 also with warnings)."""
+    from vehicles.check import check_vehicle, format_check
+    from vehicles.params import load_vehicle
+
+    rep = check_vehicle(load_vehicle(args.vehicle))
+    if args.json:
+        print(json.dumps(rep, indent=2, default=float))
+    else:
+        print(format_check(rep))
     return 0
