@@ -91,7 +91,6 @@ def test_spring_1000x_too_stiff_and_damping_and_tyre():
                     "be 1.37e+04 N s/m with this spring and load)"]
     msgs = [w["message"] for w in check_vehicle(_scaled(vp, 3, tyre_stiffness=1e-2))["warnings"]]
     assert any(m.startswith("axle 4: tyre_stiffness = 1e+04 N/m per tyre is far too soft") for m in msgs)
-    assert any("axle hop" in m for m in msgs)
 
 
 def test_modest_changes_stay_quiet():

@@ -247,7 +247,9 @@ def check_vehicle(vp: VehicleParams) -> dict:
                              r["tyres_per_side"] * r["tyre_stiffness_Npm"], 0.0)
             lo, hi = RANGES["body_bounce_hz"][:2]
             f_b = qc["body_bounce_hz"]
-            if not lo <= f_b <= hi:
+            k_tyres = r["tyres_per_side"] * r["tyre_stiffness_Npm"]
+            tyre_limits = f_b < lo and m_sh * (2 * math.pi * lo) ** 2 >= k_tyres
+            if not lo <= f_b <= hi and not tyre_limits:   # (a too soft tyre: judged below)
                 soft = f_b < lo
                 # the spring that, in series with the tyres, gives the range's end
                 k_e = m_sh * (2 * math.pi * (lo if soft else hi)) ** 2
@@ -288,7 +290,7 @@ def check_vehicle(vp: VehicleParams) -> dict:
                 f"{w}: carries {r['spring_load_kN']:.3g} kN on its springs, {ratio:.2g}x its "
                 f"share with equally stiff axles ({r['equal_share_kN']:.3g} kN): its springs are "
                 f"{'much stiffer' if ratio > 1 else 'much softer'} than the other axles' "
-                "(or another axle's spring is off; see the other warnings)"))
+                "(or a spring or tyre is off; see the other warnings)"))
         # the tyre
         f_ty = _outside(r["tyre_deflection_m"], *RANGES["tyre_deflection_m"][:2])
         # with a spring far off, the tyre load and the hop follow from it: not repeated
