@@ -33,6 +33,8 @@ from matplotlib.figure import Figure
 
 from eroad.errors import EroadInputError
 
+from .verdict import decide
+
 __all__ = ["build_summary", "write_report", "plot_heatmap", "plot_segments",
            "plot_transmissibility", "plot_ranking", "plot_shrink_bands", "render_markdown",
            "jsonable"]
@@ -56,7 +58,7 @@ def jsonable(obj: Any) -> Any:
 
 
 def build_summary(localization=None, *, transmissibility=None, front_rear=None, shape=None,
-                  ranking=None, meta: Mapping | None = None) -> dict:
+                  ranking=None, meta: Mapping | None = None, signature=None) -> dict:
     """Machine-readable summary of a diagnosis.
 
     Parameters
@@ -68,6 +70,11 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
     ranking : diagnosis.which.Ranking, optional
     meta : mapping, optional
         Dataset, vehicle, command line, versions... copied under ``meta``.
+    signature : diagnosis.verdict.Signature, optional
+        Transmissibility of the ranking's winner against the measurement.
+
+    The verdict is :func:`diagnosis.verdict.decide` on this summary (the ranking's own
+    decision is kept under ``ranking_decision``).
 
     Returns
     -------
@@ -101,6 +108,7 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
     if ranking is not None:
         R = ranking
         s["verdict"], s["verdict_confidence"], s["verdict_reason"] = R.verdict, R.confidence, R.reason
+        s["ranking_decision"] = {"verdict": R.verdict, "confidence": R.confidence, "reason": R.reason}
         s["ranking"] = R.records()
         s["nominal"] = {"heldout_gap": float(np.mean(R.before)), "heldout_gap_per_seed": R.before,
                         "per_band": R.per_band_before, "noise_floor": R.floor,
@@ -124,6 +132,16 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
                 "per_band": [{"band_hz": [float(b[0]), float(b[2])], "band_centre_hz": float(b[1]),
                               "gap_before": pb0[i], "gap_after": pb1[i], "shrink": sh[i]}
                              for i, b in enumerate(R.bands)]}
+        if signature is not None:
+            s["signature"] = signature.record()
+        s = jsonable(s)
+        d = decide(s)
+        s["verdict"], s["verdict_confidence"], s["verdict_reason"] = (d["verdict"], d["confidence"],
+                                                                      d["reason"])
+        s["verdict_detail"] = {k: v for k, v in d.items() if k not in ("verdict", "confidence",
+                                                                      "reason")}
+        if s["how_far"] is not None:
+            s["how_far"]["is_verdict"] = s["how_far"]["effect"] == s["verdict"]
     return jsonable(s)
 
 
@@ -311,6 +329,33 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                  f"shrink fraction {H['shrink_fraction']:.2f} +- {_fmt(H['shrink_spread'], '{:.2f}')} "
                  f"across road-phase seeds (shrink of the part above sampling noise: "
                  f"{_fmt(H['shrink_excess'], '{:.2f}')}).\n")
+    D = summary.get("verdict_detail")
+    if D and D.get("residual"):
+        R = D["residual"]
+        L.append("## What is left\n")
+        model = "the nominal model" if R["model"] == "nominal" else f"the model with {R['model']}"
+        L.append(f"Held-out gap of {model}: {_fmt(R['heldout_gap'])}; a correct model reaches "
+                 f"{_fmt(R['correct_model_gap'])} +- {_fmt(R['correct_model_sd'], '{:.2g}')} "
+                 f"(the nominal model scored against surrogate measurements it made itself); the "
+                 f"nominal model: {_fmt(R['nominal_gap'])}."
+                 + (f" The explained share of the gap above a correct model's is "
+                    f"{D['explained_share']:.0%} (a named effect needs "
+                    f"{D['thresholds']['share_min']:.0%})." if D.get("explained_share") is not None
+                    else ""))
+        if R.get("bands_left"):
+            L.append(" Bands furthest above the sampling floor: "
+                     + ", ".join(f"{b['band_centre_hz']:.3g} Hz ({b['gap']:.3g} against "
+                                 f"{b['sampling_floor']:.3g})" for b in R["bands_left"]) + ".")
+        S = summary.get("signature")
+        if S:
+            L.append(f" Axle-to-body transmissibility against the measurement (mean z^2 over "
+                     f"{S['n_cells']} cells; about 1 for a correct model): nominal "
+                     f"{_fmt(S['chi2_nominal'])}, with {S['model']} {_fmt(S['chi2_model'])}"
+                     + (f"; still off: {', '.join(S['pairs_off'])}" if S.get("pairs_off") else "")
+                     + ".")
+        if D.get("edge"):
+            L.append(f" Calibrated at the edge of the search range: {', '.join(D['edge'])}.")
+        L.append("")
     st = summary.get("localization_settings")
     if st:
         L.append("## Where the gap lies\n")
@@ -446,14 +491,14 @@ def _terms_text(settings: Mapping) -> str:
 
 def write_report(out: str | os.PathLike, *, localization=None, transmissibility=None,
                  front_rear=None, shape=None, ranking=None, meta: Mapping | None = None,
-                 force: bool = False) -> Path:
+                 force: bool = False, signature=None) -> Path:
     """Write ``summary.json``, ``figures/*.png`` and ``report.md`` into ``out``.
 
     Parameters
     ----------
     out : path
         Run folder; refused if it exists and is not empty unless ``force``.
-    localization, transmissibility, front_rear, shape, ranking, meta
+    localization, transmissibility, front_rear, shape, ranking, meta, signature
         As for :func:`build_summary`.
     force : bool
         Replace an existing non-empty ``out`` (only after the new one is complete).
@@ -467,7 +512,7 @@ def write_report(out: str | os.PathLike, *, localization=None, transmissibility=
     if out.exists() and (not out.is_dir() or any(out.iterdir())) and not force:
         raise EroadInputError(f"{out} exists and is not empty (use --force to replace it)")
     summary = build_summary(localization, transmissibility=transmissibility, front_rear=front_rear,
-                            shape=shape, ranking=ranking, meta=meta)
+                            shape=shape, ranking=ranking, meta=meta, signature=signature)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
     try:

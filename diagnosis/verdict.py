@@ -1,0 +1,255 @@
+"""The verdict of a diagnosis: ``none``, an effect, or ``unexplained`` -- what the data say.
+
+What it is for: the last step of ``eroad diagnose``.  The ranking
+(:mod:`diagnosis.which`) says which library effect shrinks the held-out gap beyond
+road-phase noise; that is not yet an explanation.  A real truck differs from its model
+in ways no library lists, and the library effect nearest to such a difference also
+shrinks the gap (on drives of the independent truth family, right and wrong effects
+reached similar shrink fractions).  This module decides from the ranking AND two
+further checks, using only what ``summary.json`` holds, so a saved summary can be
+re-decided (:func:`redecide`) with other thresholds -- how the thresholds were set on
+one truth family and checked on the other (``benchmarks/bench_diagnosis.py``).
+
+Vocabulary
+----------
+``none``
+    No gap beyond noise (the nominal held-out gap is within ``z`` sd of the
+    nominal-vs-nominal gap) and no candidate explains part of it.
+``<effect>`` (or ``a+b``)
+    Named only when all hold:
+
+    1. the ranking accepted it (held-out improvement beyond its paired null, lower BIC);
+    2. it explains at least ``SHARE_MIN`` of the held-out gap ABOVE the gap of a correct
+       model (:func:`explained_share`: ``(before - after) / (before - g0)``, ``g0`` the
+       nominal-vs-nominal gap);
+    3. its road-independent signature agrees: driven over the same road as the nominal
+       model, the calibrated model's axle-to-body transmissibility (a ratio of channels
+       of one record: the road cancels) matches the measurement to within
+       ``SIGNATURE_CHI2_MAX`` (mean z^2 over the tested pair x band cells; about 1 for a
+       correct model) -- or at least no worse than the nominal model's where that is
+       already within it.  The front-to-rear delay and the amplitude distribution
+       (skewness) are terms of every gap the ranking scores, so 1. already asks them.
+
+    ``confidence`` is ``clear`` when no rival sharing no effect comes within the
+    nominal-vs-nominal gap's sd and the calibrated parameter is not at an edge of its
+    search range; else ``ambiguous``.  A calibration at a range edge is never ``clear``.
+``unexplained``
+    A gap is there (nominal gap beyond noise, or an accepted candidate) and no library
+    effect passes 1-3.  The closest candidate, the share it explains, the bands where
+    the gap stays above a correct model's and the transmissibility pairs still off are
+    reported.
+
+What it is not: the statistics (``diagnosis.which``, ``diagnosis.compare``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping, Sequence
+
+import numpy as np
+
+#: least share of the held-out gap above a correct model's that a named effect explains
+#: (set on the nominal truth family, checked on the independent one: docs/diagnosis.md)
+SHARE_MIN = 0.4
+#: largest mean z^2 of the calibrated model's axle-to-body transmissibility against the
+#: measurement for its signature to agree (a correct model gives about 1; the standard
+#: errors carry a 1 % leakage floor, see diagnosis.compare.transmissibility)
+SIGNATURE_CHI2_MAX = 2.0
+#: a calibrated parameter within this share of its search range (unit coordinates, log
+#: where searched in log) of either end is "at the edge"
+EDGE_TOL = 0.02
+
+
+@dataclass(frozen=True)
+class Signature:
+    """Axle-to-body transmissibility of the nominal and of the candidate model against the
+    measurement: mean z^2 over the tested cells and the number flagged (BH)."""
+
+    model: str
+    chi2_nominal: float
+    chi2_model: float
+    n_cells: int
+    flagged_nominal: int
+    flagged_model: int
+    pairs_off: tuple = ()
+
+    def record(self) -> dict:
+        return {"model": self.model, "chi2_nominal": _f(self.chi2_nominal),
+                "chi2_model": _f(self.chi2_model), "n_cells": int(self.n_cells),
+                "flagged_nominal": int(self.flagged_nominal),
+                "flagged_model": int(self.flagged_model), "pairs_off": list(self.pairs_off),
+                "measure": "mean of ((ln|H_meas| - ln|H_sim|) / se)^2 over tested pair x band "
+                           "cells, axle to body acceleration per wheel position"}
+
+
+def _f(v):
+    v = float(v)
+    return v if math.isfinite(v) else None
+
+
+def transmissibility_chi2(tr) -> tuple[float, int, int, tuple]:
+    """(mean z^2, tested cells, flagged cells, pairs with a flagged cell) of a
+    :class:`diagnosis.compare.Transmissibility`."""
+    z = np.asarray(tr.log_ratio, float) / np.asarray(tr.se, float)
+    ok = np.isfinite(z)
+    sig = np.asarray(tr.significant, bool) & ok
+    pairs = tuple(f"{a}->{b}" for (a, b), row in zip(tr.pairs, sig) if row.any())
+    n = int(ok.sum())
+    return (float(np.mean(z[ok] ** 2)) if n else float("nan")), n, int(sig.sum()), pairs
+
+
+def signature(model_name: str, tr_nominal, tr_model) -> Signature:
+    c0, n0, f0, _ = transmissibility_chi2(tr_nominal)
+    c1, n1, f1, p1 = transmissibility_chi2(tr_model)
+    return Signature(model_name, c0, c1, min(n0, n1), f0, f1, p1)
+
+
+def edge_parameters(params: Mapping, ranges: Mapping, tol: float = EDGE_TOL) -> list[str]:
+    """Names ``effect.param`` of calibrated values within ``tol`` (unit coordinates) of an
+    end of their search range ``ranges[effect][param] = [lo, hi, log]``."""
+    out = []
+    for eff, pv in (params or {}).items():
+        for p, (lo, hi, log) in (ranges.get(eff) or {}).items():
+            if p not in pv or pv[p] is None:
+                continue
+            x = float(pv[p])
+            if log and lo > 0 and x > 0:
+                u = (math.log(x) - math.log(lo)) / (math.log(hi) - math.log(lo))
+            else:
+                u = (x - lo) / (hi - lo)
+            if u <= tol or u >= 1.0 - tol:
+                out.append(f"{eff}.{p}")
+    return out
+
+
+def _entry_edges(entry: Mapping, ranges: Mapping) -> list[str]:
+    folds = entry.get("parameters_per_fold") or [entry.get("parameters") or {}]
+    return sorted({e for p in folds for e in edge_parameters(p, ranges)})
+
+
+def explained_share(entry: Mapping, nominal: Mapping) -> float:
+    """Share of the held-out gap above a correct model's that ``entry`` removes:
+    ``(before - after) / (before - g0)``, ``g0`` the nominal-vs-nominal gap (the nominal
+    model scored against surrogate measurements the nominal model made: what a correct
+    model reaches against one measurement).  NaN where the nominal gap is not above g0."""
+    g0 = nominal.get("null_gap_mean")
+    b, a = entry.get("heldout_gap_before"), entry.get("heldout_gap_after")
+    if g0 is None or b is None or a is None or not b > g0:
+        return float("nan")
+    return float((b - a) / (b - g0))
+
+
+def residual(summary: Mapping, entry: Mapping | None, top: int = 3) -> dict:
+    """What is left: the held-out gap after ``entry`` (or the nominal model) against the gap
+    of a correct model, and the bands where it stays furthest above."""
+    nom = summary.get("nominal") or {}
+    fc = nom.get("band_centres_hz") or []
+    floor_b = np.asarray([np.nan if v is None else v for v in nom.get("per_band_noise_floor") or []],
+                         float)
+    after_b = (entry or {}).get("per_band_after") or nom.get("per_band") or []
+    after_b = np.asarray([np.nan if v is None else v for v in after_b], float)
+    bands = []
+    if after_b.size and after_b.size == floor_b.size == len(fc):
+        ex = after_b - floor_b
+        for i in np.argsort(-np.nan_to_num(ex, nan=-np.inf))[:top]:
+            if np.isfinite(ex[i]) and ex[i] > 0:
+                bands.append({"band_centre_hz": float(fc[i]), "gap": float(after_b[i]),
+                              "sampling_floor": float(floor_b[i])})
+    gap = float(entry["heldout_gap_after"]) if entry else float(nom.get("heldout_gap", float("nan")))
+    return {"model": entry["effect"] if entry else "nominal", "heldout_gap": gap,
+            "correct_model_gap": _f(nom.get("null_gap_mean", float("nan"))),
+            "correct_model_sd": _f(nom.get("null_gap_std", float("nan"))),
+            "sampling_floor": _f(nom.get("noise_floor", float("nan"))),
+            "nominal_gap": _f(nom.get("heldout_gap", float("nan"))),
+            "bands_left": bands}
+
+
+def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
+           signature_max: float = SIGNATURE_CHI2_MAX) -> dict:
+    """Verdict, confidence, reason and what is left, from a diagnosis summary.
+
+    Reads ``summary["ranking"]`` (entries, accepted first), ``summary["ranking_decision"]``
+    (the ranking's own verdict and confidence), ``summary["nominal"]``,
+    ``summary.get("signature")`` and ``summary["meta"]["search_ranges"]``.
+
+    Returns
+    -------
+    dict with ``verdict``, ``confidence``, ``reason``, ``explained_share``,
+    ``closest`` (effect or None), ``edge`` (list), ``signature_agrees`` (bool or None),
+    ``residual`` (see :func:`residual`), ``thresholds``.
+    """
+    nom = summary.get("nominal") or {}
+    rd = summary.get("ranking_decision") or {}
+    ranking = list(summary.get("ranking") or [])
+    ranges = (summary.get("meta") or {}).get("search_ranges") or {}
+    gap_present = bool(nom.get("gap_present", False))
+    rv = rd.get("verdict", "none")
+    win = next((e for e in ranking if e.get("effect") == rv and e.get("accepted")), None)
+    thresholds = {"share_min": share_min, "signature_chi2_max": signature_max,
+                  "edge_tol": EDGE_TOL}
+    base = {"explained_share": None, "closest": None, "edge": [], "signature_agrees": None,
+            "thresholds": thresholds, "ranking_verdict": rv,
+            "ranking_confidence": rd.get("confidence", "none")}
+    if win is None:
+        if not gap_present:
+            return dict(base, verdict="none", confidence="none",
+                        reason=rd.get("reason") or "no gap beyond noise",
+                        residual=residual(summary, None))
+        best = ranking[0] if ranking else None
+        return dict(base, verdict="unexplained", confidence="none",
+                    closest=best["effect"] if best else None,
+                    explained_share=_f(explained_share(best, nom)) if best else None,
+                    reason=("the nominal model leaves a held-out gap beyond noise (gap "
+                            f"{nom.get('heldout_gap', float('nan')):.3g} against "
+                            f"{nom.get('null_gap_mean', float('nan')):.3g} +- "
+                            f"{nom.get('null_gap_std', float('nan')):.2g} for a correct model) and "
+                            "no library effect reduces it beyond noise"),
+                    residual=residual(summary, None))
+    share = explained_share(win, nom)
+    edges = _entry_edges(win, ranges)
+    sig = summary.get("signature") or {}
+    c0, c1 = sig.get("chi2_nominal"), sig.get("chi2_model")
+    if c1 is None:
+        agrees = None
+    else:
+        agrees = bool(c1 <= signature_max or (c0 is not None and c0 <= signature_max
+                                              and c1 <= c0))
+    out = dict(base, explained_share=_f(share), closest=win["effect"], edge=edges,
+               signature_agrees=agrees, residual=residual(summary, win))
+    short = []
+    if not (share >= share_min):
+        short.append(f"it explains {share:.0%} of the held-out gap above a correct model's "
+                     f"(at least {share_min:.0%} asked)" if math.isfinite(share) else
+                     "its share of the gap above a correct model's is undefined")
+    if agrees is False:
+        short.append(f"its axle-to-body transmissibility still disagrees with the measurement "
+                     f"(mean z^2 {c1:.2g}, nominal {c0:.2g}, at most {signature_max:g} asked"
+                     + (f"; off: {', '.join(sig.get('pairs_off', [])[:4])}" if sig.get("pairs_off")
+                        else "") + ")")
+    if short:
+        return dict(out, verdict="unexplained", confidence="none",
+                    reason=(f"a gap is there and no library effect explains it: the closest, "
+                            f"{win['effect']}, shrinks the held-out gap from "
+                            f"{win['heldout_gap_before']:.3g} to {win['heldout_gap_after']:.3g}, but "
+                            + "; and ".join(short)))
+    conf = rd.get("confidence", "clear")
+    reason = rd.get("reason") or ""
+    reason += (f"; it explains {share:.0%} of the gap above a correct model's"
+               + ("" if agrees is None else "; its transmissibility agrees with the measurement"))
+    if edges:
+        conf = "ambiguous"
+        reason += (f"; calibrated at the edge of its search range ({', '.join(edges)}): the "
+                   f"value is a bound, not an estimate")
+    return dict(out, verdict=rv, confidence=conf, reason=reason)
+
+
+def redecide(summary: Mapping, **thresholds) -> dict:
+    """:func:`decide` on a saved summary with other thresholds (benchmarks)."""
+    return decide(summary, **thresholds)
+
+
+def search_ranges(candidates: Sequence) -> dict:
+    """``{effect: {param: [lo, hi, log]}}`` of :class:`diagnosis.which.Candidate` objects."""
+    return {c.name: {p.name: [float(p.lo), float(p.hi), bool(p.log)] for p in c.params}
+            for c in candidates}

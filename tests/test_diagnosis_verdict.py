@@ -1,0 +1,95 @@
+"""diagnosis.verdict: the vocabulary none / effect / unexplained, decided from a summary.
+
+Summaries are built by hand here (the numbers are chosen, not simulated), so each rule is
+checked on its own: an accepted effect that explains too little, or whose transmissibility
+still disagrees, is "unexplained"; a gap with no accepted effect is "unexplained"; no gap
+and nothing accepted is "none"; a calibration at a search-range edge is never "clear".
+"""
+import math
+
+import pytest
+
+from diagnosis.verdict import (EDGE_TOL, SHARE_MIN, SIGNATURE_CHI2_MAX, decide, edge_parameters,
+                               explained_share)
+
+
+def _summary(*, before=1.0, after=0.45, null_mean=0.4, null_sd=0.05, gap_present=True,
+             accepted=True, rverdict="leaf_friction", rconf="clear", chi2=(3.0, 1.1),
+             force=4000.0, folds=None):
+    entry = {"effect": "leaf_friction", "accepted": accepted, "heldout_gap_before": before,
+             "heldout_gap_after": after, "parameters": {"leaf_friction": {"force": force}},
+             "per_band_after": [0.5, 0.9, 0.3]}
+    if folds:
+        entry["parameters_per_fold"] = [{"leaf_friction": {"force": f}} for f in folds]
+    s = {"ranking": [entry, {"effect": "sensor", "accepted": False, "heldout_gap_before": before,
+                             "heldout_gap_after": before * 0.99, "parameters": {}}],
+         "ranking_decision": {"verdict": rverdict if accepted else "none",
+                              "confidence": rconf if accepted else "none", "reason": "r"},
+         "nominal": {"heldout_gap": before, "null_gap_mean": null_mean, "null_gap_std": null_sd,
+                     "gap_present": gap_present, "noise_floor": 0.2,
+                     "per_band": [1.0, 1.5, 0.4], "per_band_noise_floor": [0.2, 0.3, 0.25],
+                     "band_centres_hz": [1.0, 4.0, 16.0]},
+         "meta": {"search_ranges": {"leaf_friction": {"force": [200.0, 12000.0, True]}}}}
+    if chi2 is not None:
+        s["signature"] = {"model": "leaf_friction", "chi2_nominal": chi2[0], "chi2_model": chi2[1],
+                          "n_cells": 40, "flagged_nominal": 6, "flagged_model": 0, "pairs_off": []}
+    return s
+
+
+def test_share_is_of_the_gap_above_a_correct_model():
+    # (1.0 - 0.45) / (1.0 - 0.4) = 0.9166...
+    assert explained_share({"heldout_gap_before": 1.0, "heldout_gap_after": 0.45},
+                           {"null_gap_mean": 0.4}) == pytest.approx(0.55 / 0.6, rel=1e-12)
+    assert math.isnan(explained_share({"heldout_gap_before": 0.3, "heldout_gap_after": 0.2},
+                                      {"null_gap_mean": 0.4}))
+
+
+def test_accepted_explaining_and_agreeing_effect_is_named():
+    d = decide(_summary())
+    assert (d["verdict"], d["confidence"]) == ("leaf_friction", "clear")
+    assert d["signature_agrees"] is True and d["edge"] == []
+
+
+def test_too_small_a_share_is_unexplained():
+    # after chosen so the share is just below the threshold
+    after = 1.0 - (SHARE_MIN - 0.05) * 0.6
+    d = decide(_summary(after=after))
+    assert d["verdict"] == "unexplained" and d["confidence"] == "none"
+    assert d["closest"] == "leaf_friction" and "explains" in d["reason"]
+
+
+def test_disagreeing_signature_is_unexplained():
+    d = decide(_summary(chi2=(3.0, SIGNATURE_CHI2_MAX + 1.0)))
+    assert d["verdict"] == "unexplained" and d["signature_agrees"] is False
+    assert "transmissibility" in d["reason"]
+    # a model no worse than a nominal that already agrees is not held against the effect
+    d = decide(_summary(chi2=(1.2, 1.1)))
+    assert d["verdict"] == "leaf_friction"
+
+
+def test_gap_without_accepted_effect_is_unexplained_and_no_gap_is_none():
+    d = decide(_summary(accepted=False))
+    assert d["verdict"] == "unexplained"
+    assert d["residual"]["model"] == "nominal" and d["residual"]["bands_left"]
+    assert decide(_summary(accepted=False, gap_present=False))["verdict"] == "none"
+
+
+@pytest.mark.parametrize("force,edge", [(200.0, True), (12000.0, True), (11900.0, True),
+                                        (4000.0, False)])
+def test_edge_calibration_is_never_clear(force, edge):
+    # 11900 N: u = ln(11900/200)/ln(60) = 0.998, inside EDGE_TOL of the upper end
+    d = decide(_summary(force=force))
+    assert d["verdict"] == "leaf_friction"
+    assert (d["confidence"] == "ambiguous") is edge
+    assert bool(d["edge"]) is edge
+
+
+def test_edge_in_any_fold_counts():
+    d = decide(_summary(folds=[4000.0, 12000.0]))
+    assert d["confidence"] == "ambiguous" and d["edge"] == ["leaf_friction.force"]
+
+
+def test_edge_parameters_linear_and_log():
+    r = {"payload": {"mass": [-1000.0, 1000.0, False]}}
+    assert edge_parameters({"payload": {"mass": -1000.0 + 2000 * EDGE_TOL / 2}}, r) == ["payload.mass"]
+    assert edge_parameters({"payload": {"mass": 0.0}}, r) == []
