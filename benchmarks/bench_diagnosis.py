@@ -57,7 +57,30 @@ def main(argv=None) -> int:
                     help="ranking folds (default: that of diagnosis.blind.BLIND_SETTINGS)")
     ap.add_argument("--null-only", action="store_true",
                     help="every case a null drive (the extra null validation: --seed 1)")
+    ap.add_argument("--family", choices=("nominal", "second"), default="nominal",
+                    help="truth family: the Exudyn truck plus one effect (nominal), or the "
+                         "independently written truck with out-of-library differences (second)")
+    ap.add_argument("--rescore", action="store_true",
+                    help="re-decide the saved cases of --out with the thresholds given below "
+                         "(no simulation) and print the score")
+    ap.add_argument("--share-min", type=float, default=None)
+    ap.add_argument("--signature-max", type=float, default=None)
+    ap.add_argument("--signature-share", type=float, default=None)
     args = ap.parse_args(argv)
+
+    if args.rescore:
+        from diagnosis.blind import format_confusion, rescore
+
+        th = {k: v for k, v in (("share_min", args.share_min), ("signature_max", args.signature_max),
+                                ("signature_share", args.signature_share)) if v is not None}
+        out = rescore(args.out, **th)
+        print(f"thresholds {th or 'defaults'}")
+        print(format_confusion(out["score"]))
+        sc = out["score"]
+        print(json.dumps({k: sc[k] for k in ("n_cases", "effect_top1_accuracy",
+                                            "null_none_or_unexplained_rate", "confident_wrong",
+                                            "param_within_1p5_rate", "by_family")}, indent=1))
+        return 0
 
     from diagnosis.blind import format_confusion, run_blind
 
@@ -66,7 +89,7 @@ def main(argv=None) -> int:
     t = time.perf_counter()
     out = run_blind(args.out, args.n, seed=args.seed, workers=args.workers, duration=args.duration,
                     settings=None if args.folds is None else {"folds": args.folds},
-                    n_null=args.n if args.null_only else None,
+                    n_null=args.n if args.null_only else None, family=args.family,
                     progress=lambda m: print(m, flush=True))
     wall = time.perf_counter() - t
     sc = out["score"]
@@ -76,6 +99,8 @@ def main(argv=None) -> int:
     d = [r["diagnose_s"] for r in res]
     print(f"\ncases {sc['n_cases']}: top-1 {sc['top1_accuracy']:.2f} (effect cases "
           f"{sc['effect_top1_accuracy']:.2f}), null 'none' {sc['null_none_rate']:.2f}, "
+          f"'none' or 'unexplained' {sc['null_none_or_unexplained_rate']:.2f}, parameter within "
+          f"x1.5 {sc['param_within_1p5_rate']:.2f}, "
           f"confident wrong {sc['confident_wrong']}, localisation hits on effect cases "
           f"{sc['localisation_hit_rate_effects']:.2f}, flagged cells on null cases "
           f"{sc['null_flagged_cells']}, mean |pred - true shrink| {sc['shrink_mean_abs_diff']}")

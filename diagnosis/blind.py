@@ -72,7 +72,20 @@ Z_PAIRED = 3.0
 BLIND_SETTINGS = dict(n_seeds=4, n_null=12, grid=4, refine=3, pairs=False, folds=2)
 
 
-def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None) -> list[dict]:
+#: truth families: the scenario a case is made from, and the effects it can carry.
+#: ``nominal``: the Exudyn truck itself plus one library effect (null scenario);
+#: ``second``: the independently written truck (drives/independent_truck.py, scenario
+#: ``second``) with its out-of-library differences (roll centres, anti-roll bars, a cab on
+#: mounts, progressive tyres with lift-off, axle-guide geometry), plus one library effect
+#: it also models (leaf friction, payload) or none; its null cases carry only the
+#: out-of-library differences, and "none" or "unexplained" is the right answer there.
+FAMILIES = {"nominal": ("null", tuple(STRENGTHS)), "second": ("second", ("leaf_friction", "payload"))}
+#: verdicts that are right where no library effect is in the truth
+NO_EFFECT_ANSWERS = ("none", "unexplained")
+
+
+def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
+               family: str = "nominal") -> list[dict]:
     """``n`` blind cases: effects in turn (strength drawn per case), every ``k``-th a null case.
 
     Parameters
@@ -83,22 +96,31 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None) -
         Root seed; case ``i`` uses dataset seed ``1000 * seed + 100 + i`` and strength stream
         ``SeedSequence(seed, spawn_key=(7, i))``.
     n_null : int, optional
-        Null cases among them (default ``round(n / 5)``, at least 1).
+        Null cases among them (default ``round(n / 5)``, at least 1; family ``second``:
+        half of them).
     effects : sequence of str, optional
-        Effects used (default all of :data:`STRENGTHS`).
+        Effects used (default all the family can carry, :data:`FAMILIES`).
+    family : {"nominal", "second"}
+        Truth family (:data:`FAMILIES`); ``second`` case seeds are offset by 50000.
 
     Returns
     -------
     list of dict with ``case``, ``seed``, ``effect`` ("none" for null), ``param``, ``value``.
     """
-    names = list(effects or STRENGTHS)
-    n_null = max(1, round(n / 5)) if n_null is None else n_null
+    if family not in FAMILIES:
+        raise ValueError(f"family must be one of {', '.join(FAMILIES)}, got {family!r}")
+    scenario, fam_effects = FAMILIES[family]
+    names = list(effects or fam_effects)
+    if n_null is None:
+        n_null = max(1, round(n / 5)) if family == "nominal" else n // 2
+    off = 0 if family == "nominal" else 50000
     null_at = set(np.linspace(0, n - 1, n_null).round().astype(int).tolist()) if n_null else set()
     cases, k = [], 0
     for i in range(n):
-        ds_seed = 1000 * seed + 100 + i
+        ds_seed = 1000 * seed + 100 + i + off
+        tag = dict(family=family, scenario=scenario)
         if i in null_at:
-            cases.append(dict(case=i, seed=ds_seed, effect="none", param=None, value=None))
+            cases.append(dict(case=i, seed=ds_seed, effect="none", param=None, value=None, **tag))
             continue
         name = names[k % len(names)]
         k += 1
@@ -108,7 +130,7 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None) -
         v = math.exp(math.log(lo) + u * (math.log(hi) - math.log(lo))) if log else lo + u * (hi - lo)
         sign = (1.0 if rng.uniform() < 0.5 else -1.0) if signed else 1.0
         v = 1.0 + sign * v if name == "speed_scale" else sign * v
-        cases.append(dict(case=i, seed=ds_seed, effect=name, param=pname, value=float(v)))
+        cases.append(dict(case=i, seed=ds_seed, effect=name, param=pname, value=float(v), **tag))
     return cases
 
 
@@ -150,7 +172,8 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
         # measurement format (e.g. |axle_acc| > 200 m/s^2): redraw road and speed
         for attempt in range(6):
             try:
-                synth_command(scenario="null", seed=case["seed"], effects=eff_items, out=ds,
+                synth_command(scenario=case.get("scenario", "null"), seed=case["seed"],
+                              effects=eff_items, out=ds,
                               force=True, duration=duration)
                 break
             except EroadInputError as exc:
@@ -167,7 +190,9 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
     t2 = _time.perf_counter()
     # scoring only from here: truth is read
     truth = read_truth(ds)
-    truth_eff = truth["vehicle"]["truth"]["effects"]
+    truth_eff = (truth.get("vehicle", {}).get("truth", {}) or {}).get("effects") or {}
+    if case.get("family", "nominal") != "nominal":
+        truth_eff = {}      # no oracle: the Exudyn model with the effect is not the truth
     case = dict(case, seed=int(truth.get("seed", case["seed"])))   # the seed actually used
     verdict = summ["verdict"]
     entry = next((e for e in summ.get("ranking", []) if e["effect"] == verdict), None)
@@ -180,10 +205,13 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
         hs = heldout_shrink(blind, oracle, n_seeds=settings["n_seeds"], n_null=settings["n_null"])
         true_shrink, true_z = hs["shrink_fraction"], hs["paired_z"]
     t3 = _time.perf_counter()
+    detail = summ.get("verdict_detail") or {}
     res = dict(case, verdict=verdict, confidence=summ.get("verdict_confidence"),
-               correct=(verdict == case["effect"]),
-               confident_wrong=(verdict != case["effect"] and verdict != "none"
-                                and summ.get("verdict_confidence") == "clear"),
+               **judge(case, verdict, summ.get("verdict_confidence")),
+               param_ratio=param_ratio(case, entry),
+               ranking_verdict=detail.get("ranking_verdict"),
+               explained_share=detail.get("explained_share"),
+               signature=summ.get("signature"), summary=str(run / "summary.json"),
                localisation_hit=localisation_hit(summ, case["effect"], case["value"]),
                n_flagged=sum(1 for c in summ.get("localization", []) if c.get("significant")),
                predicted_shrink=pred_shrink, true_shrink=true_shrink, true_paired_z=true_z,
@@ -197,6 +225,52 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
              f"true {'-' if true_shrink is None else format(true_shrink, '.2f')}  "
              f"loc {'hit' if res['localisation_hit'] else 'miss'}  {t2 - t1:.0f} s")
     return res
+
+
+def judge(case: dict, verdict: str, confidence) -> dict:
+    """``correct`` and ``confident_wrong`` of one verdict: right is the truth effect, or
+    "none" / "unexplained" where the truth carries no library effect; a confident wrong
+    answer names another effect with confidence "clear"."""
+    if case["effect"] == "none":
+        correct = verdict in NO_EFFECT_ANSWERS
+    else:
+        correct = verdict == case["effect"]
+    wrong_name = verdict not in NO_EFFECT_ANSWERS and verdict != case["effect"]
+    return {"correct": bool(correct), "confident_wrong": bool(wrong_name and confidence == "clear")}
+
+
+def param_ratio(case: dict, entry) -> float | None:
+    """Calibrated over true value of the effect's parameter (same sign asked; None where
+    the verdict is not the truth effect).  speed_scale: ratio of the deviations from 1."""
+    if entry is None or case["effect"] == "none" or entry.get("effect") != case["effect"]:
+        return None
+    got = (entry.get("parameters") or {}).get(case["effect"], {}).get(case["param"])
+    if got is None:
+        return None
+    got, true = float(got), float(case["value"])
+    if case["effect"] == "speed_scale":
+        got, true = got - 1.0, true - 1.0
+    return got / true if true else None
+
+
+def rescore(root, **thresholds) -> dict:
+    """Re-decide every case of ``root/blind.json`` from its saved summary with other
+    thresholds of :func:`diagnosis.verdict.decide`; returns ``{"results", "score"}``."""
+    from diagnosis.verdict import decide
+
+    root = Path(root)
+    results = []
+    for r in json.loads((root / "blind.json").read_text())["results"]:
+        p = Path(r.get("summary") or root / f"case{r['case']:03d}-run" / "summary.json")
+        if not p.is_file():
+            continue
+        summ = json.loads(p.read_text())
+        d = decide(summ, **thresholds)
+        entry = next((e for e in summ.get("ranking", []) if e["effect"] == d["verdict"]), None)
+        results.append(dict(r, verdict=d["verdict"], confidence=d["confidence"],
+                            **judge(r, d["verdict"], d["confidence"]),
+                            param_ratio=param_ratio(r, entry)))
+    return {"results": results, "score": score(results)}
 
 
 def score(results: list[dict]) -> dict:
@@ -224,6 +298,20 @@ def score(results: list[dict]) -> dict:
         "undetectable_none_rate": float(np.mean([r["verdict"] == "none" for r in eff if r not in det]))
         if len(det) < len(eff) else float("nan"),
         "null_none_rate": float(np.mean([r["verdict"] == "none" for r in nul])) if nul else float("nan"),
+        "null_none_or_unexplained_rate": float(np.mean([r["verdict"] in NO_EFFECT_ANSWERS
+                                                        for r in nul])) if nul else float("nan"),
+        "param_within_1p5_rate": (float(np.mean([1 / 1.5 <= r["param_ratio"] <= 1.5 for r in eff
+                                                 if r["correct"] and r.get("param_ratio") is not None]))
+                                  if any(r["correct"] and r.get("param_ratio") is not None for r in eff)
+                                  else float("nan")),
+        "by_family": {f: {"n": len(rs), "effect_top1": float(np.mean([r["correct"] for r in rs
+                                                                      if r["effect"] != "none"]))
+                          if any(r["effect"] != "none" for r in rs) else float("nan"),
+                          "no_effect_right": float(np.mean([r["correct"] for r in rs
+                                                            if r["effect"] == "none"]))
+                          if any(r["effect"] == "none" for r in rs) else float("nan")}
+                      for f in sorted({r.get("family", "nominal") for r in results})
+                      for rs in [[r for r in results if r.get("family", "nominal") == f]]},
         "confident_wrong": int(sum(r["confident_wrong"] for r in results)),
         "localisation_hit_rate": float(np.mean([r["localisation_hit"] for r in results]))
         if results else float("nan"),
@@ -249,7 +337,7 @@ def format_confusion(sc: dict) -> str:
 
 
 def run_blind(root, n: int = 30, *, seed: int = 0, workers: int = 2, duration=None, settings=None,
-              n_null: int | None = None, progress=print) -> dict:
+              n_null: int | None = None, family: str = "nominal", progress=print) -> dict:
     """Run ``n`` blind cases under ``root``; write ``root/blind.json`` and ``root/confusion.txt``.
 
     Cases already scored in ``root/blind.json`` are reused (the run can be resumed).
@@ -263,7 +351,7 @@ def run_blind(root, n: int = 30, *, seed: int = 0, workers: int = 2, duration=No
     results = []
     t0 = _time.perf_counter()
     # case ids are stable; a redrawn road changes a case's dataset seed (recorded in results)
-    for case in make_cases(n, seed, n_null=n_null):
+    for case in make_cases(n, seed, n_null=n_null, family=family):
         r = done.get(case["case"])
         if r is None or r.get("value") != case["value"]:
             r = run_case(case, root, workers=workers, settings=settings, duration=duration,

@@ -800,10 +800,15 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
     return gq, w
 
 
-def candidates(names=None):
-    """Candidates over the library, primary parameter only, ranges of :data:`SEARCH`."""
+def candidates(names=None, vehicle=None):
+    """Candidates over the library, primary parameter only, ranges of :data:`SEARCH`
+    narrowed to what the effect allows on ``vehicle`` (``Effect.vehicle_ranges``: payload
+    never below an empty truck)."""
     from diagnosis.which import Candidate, Param
     from vehicles.effects import EFFECTS
+    from vehicles.params import load_vehicle
+
+    vp = load_vehicle(vehicle) if vehicle is not None else None
 
     out = []
     for name in (names or list(EFFECTS)):
@@ -813,6 +818,9 @@ def candidates(names=None):
         pname = eff.primary
         par = eff.parameter(pname)
         lo, hi = SEARCH.get(name, {}).get(pname, tuple(par.range))
+        if vp is not None:
+            vlo, vhi, _ = eff.vehicle_ranges(vp)[pname]
+            lo, hi = max(lo, vlo), min(hi, vhi)
         fixed = {p.name: p.default for p in eff.parameters if p.name != pname}
         fixed.update(FIXED.get(name, {}))
         out.append(Candidate(name, (Param(pname, float(lo), float(hi),
@@ -1073,7 +1081,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     # which
     t = _time.perf_counter()
     names = list(effects) if effects else (list(QUICK_EFFECTS) if quick else None)
-    cands = candidates(names)
+    cands = candidates(names, veh)
     kw = dict(n_seeds=3, n_null=6, grid=3, refine=3, pairs=False, folds=1) if quick else \
         dict(n_seeds=4, n_null=12, grid=4, refine=4, n_pair_candidates=2, folds=2)
     kw.update(settings or {})

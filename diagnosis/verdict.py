@@ -26,8 +26,8 @@ Vocabulary
        model, the calibrated model's axle-to-body transmissibility (a ratio of channels
        of one record: the road cancels) matches the measurement to within
        ``SIGNATURE_CHI2_MAX`` (mean z^2 over the tested pair x band cells; about 1 for a
-       correct model) -- or at least no worse than the nominal model's where that is
-       already within it.  The front-to-rear delay and the amplitude distribution
+       correct model) -- or, where the nominal model's is off, removes at least
+       ``SIGNATURE_SHARE_MIN`` of its excess (:func:`signature_agrees`).  The front-to-rear delay and the amplitude distribution
        (skewness) are terms of every gap the ranking scores, so 1. already asks them.
 
     ``confidence`` is ``clear`` when no rival sharing no effect comes within the
@@ -56,6 +56,9 @@ SHARE_MIN = 0.4
 #: measurement for its signature to agree (a correct model gives about 1; the standard
 #: errors carry a 1 % leakage floor, see diagnosis.compare.transmissibility)
 SIGNATURE_CHI2_MAX = 2.0
+#: or, where the nominal model's transmissibility is off, the least share of its excess
+#: (``chi2_nominal - 1``) the candidate must remove
+SIGNATURE_SHARE_MIN = 0.3
 #: a calibrated parameter within this share of its search range (unit coordinates, log
 #: where searched in log) of either end is "at the edge"
 EDGE_TOL = 0.02
@@ -165,8 +168,26 @@ def residual(summary: Mapping, entry: Mapping | None, top: int = 3) -> dict:
             "bands_left": bands}
 
 
+def signature_agrees(c0, c1, signature_max: float = SIGNATURE_CHI2_MAX,
+                     signature_share: float = SIGNATURE_SHARE_MIN):
+    """Does the candidate's transmissibility agree with the measurement?  ``c0``, ``c1``:
+    mean z^2 of the nominal and of the candidate model (None: not computed -> None).
+    Yes when ``c1 <= signature_max`` (within what a correct model gives), or when the
+    nominal model is off and the candidate removes at least ``signature_share`` of the
+    excess ``c0 - 1`` (the effect is there, beside differences no library lists: the
+    remainder is reported).  An effect that leaves an off transmissibility as it was (a
+    sensor low-pass, tyre enveloping: both act on axle and body alike) does not agree."""
+    if c1 is None:
+        return None
+    if c1 <= signature_max:
+        return True
+    return bool(c0 is not None and c0 > signature_max
+                and (c0 - c1) / (c0 - 1.0) >= signature_share)
+
+
 def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
-           signature_max: float = SIGNATURE_CHI2_MAX) -> dict:
+           signature_max: float = SIGNATURE_CHI2_MAX,
+           signature_share: float = SIGNATURE_SHARE_MIN) -> dict:
     """Verdict, confidence, reason and what is left, from a diagnosis summary.
 
     Reads ``summary["ranking"]`` (entries, accepted first), ``summary["ranking_decision"]``
@@ -187,7 +208,7 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     rv = rd.get("verdict", "none")
     win = next((e for e in ranking if e.get("effect") == rv and e.get("accepted")), None)
     thresholds = {"share_min": share_min, "signature_chi2_max": signature_max,
-                  "edge_tol": EDGE_TOL}
+                  "signature_share_min": signature_share, "edge_tol": EDGE_TOL}
     base = {"explained_share": None, "closest": None, "edge": [], "signature_agrees": None,
             "thresholds": thresholds, "ranking_verdict": rv,
             "ranking_confidence": rd.get("confidence", "none")}
@@ -210,13 +231,13 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     edges = _entry_edges(win, ranges)
     sig = summary.get("signature") or {}
     c0, c1 = sig.get("chi2_nominal"), sig.get("chi2_model")
-    if c1 is None:
-        agrees = None
-    else:
-        agrees = bool(c1 <= signature_max or (c0 is not None and c0 <= signature_max
-                                              and c1 <= c0))
+    agrees = signature_agrees(c0, c1, signature_max, signature_share)
     out = dict(base, explained_share=_f(share), closest=win["effect"], edge=edges,
                signature_agrees=agrees, residual=residual(summary, win))
+    remainder = ""
+    if agrees and c1 is not None and c1 > signature_max:
+        remainder = (f"; its transmissibility moves towards the measurement (mean z^2 {c0:.2g} "
+                     f"-> {c1:.2g}) but stays off: a difference beyond it remains")
     short = []
     if not (share >= share_min):
         short.append(f"it explains {share:.0%} of the held-out gap above a correct model's "
@@ -236,7 +257,12 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     conf = rd.get("confidence", "clear")
     reason = rd.get("reason") or ""
     reason += (f"; it explains {share:.0%} of the gap above a correct model's"
-               + ("" if agrees is None else "; its transmissibility agrees with the measurement"))
+               + ("" if agrees is None or remainder else
+                  "; its transmissibility agrees with the measurement")
+               + remainder)
+    if remainder and conf == "clear":
+        conf = "ambiguous"
+        reason += " (so not 'clear')"
     if edges:
         conf = "ambiguous"
         reason += (f"; calibrated at the edge of its search range ({', '.join(edges)}): the "

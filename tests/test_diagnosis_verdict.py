@@ -93,3 +93,12 @@ def test_edge_parameters_linear_and_log():
     r = {"payload": {"mass": [-1000.0, 1000.0, False]}}
     assert edge_parameters({"payload": {"mass": -1000.0 + 2000 * EDGE_TOL / 2}}, r) == ["payload.mass"]
     assert edge_parameters({"payload": {"mass": 0.0}}, r) == []
+
+
+def test_partial_signature_names_the_effect_but_not_clearly():
+    # nominal far off (9), the effect removes half of the excess: (9 - 5) / (9 - 1) = 0.5
+    d = decide(_summary(chi2=(9.0, 5.0)))
+    assert d["verdict"] == "leaf_friction" and d["confidence"] == "ambiguous"
+    assert "remains" in d["reason"]
+    # an effect that leaves an off transmissibility as it was does not agree
+    assert decide(_summary(chi2=(9.0, 9.0)))["verdict"] == "unexplained"
