@@ -29,3 +29,35 @@ def test_score_counts_detectable_cases_by_the_paired_gate():
     assert sc["null_none_rate"] == 1.0
     assert sc["undetectable_none_rate"] == pytest.approx(0.5)
     assert "payload" in format_confusion(sc)
+
+
+def test_judge_counts_unexplained_right_only_without_a_library_effect():
+    from diagnosis.blind import judge, param_ratio
+
+    none_case = {"effect": "none"}
+    assert judge(none_case, "unexplained", "none")["correct"]
+    assert judge(none_case, "none", "none")["correct"]
+    assert judge(none_case, "payload", "clear") == {"correct": False, "confident_wrong": True}
+    eff = {"effect": "payload", "param": "mass", "value": -8000.0}
+    assert judge(eff, "unexplained", "none") == {"correct": False, "confident_wrong": False}
+    assert judge(eff, "payload", "ambiguous")["correct"]
+    # calibrated / true, same sign asked by the caller's 1/1.5..1.5 window
+    assert param_ratio(eff, {"effect": "payload", "parameters": {"payload": {"mass": -6000.0}}}) == 0.75
+    assert param_ratio(eff, {"effect": "sensor", "parameters": {}}) is None
+
+
+@pytest.mark.slow
+def test_out_of_library_drive_is_unexplained(tmp_path):
+    """A drive of the independent truck (scenario ``second``, seed 50100: roll centres,
+    anti-roll bars, a cab on mounts, progressive tyres, axle-guide geometry; no library
+    effect) diagnosed with the whole library at the blind settings is not attributed to a
+    library effect (blind benchmark case 0 of the second family: 'unexplained')."""
+    from diagnosis.blind import BLIND_SETTINGS
+    from diagnosis.pipeline import diagnose
+    from drives.synth import copy_without_truth, synth_command
+
+    ds = tmp_path / "d"
+    synth_command(scenario="second", seed=50100, out=ds)
+    blind = copy_without_truth(ds, tmp_path / "blind")
+    s = diagnose(blind, tmp_path / "run", settings=dict(BLIND_SETTINGS), progress=lambda m: None)
+    assert s["verdict"] in ("none", "unexplained"), s["verdict_reason"]
