@@ -45,7 +45,9 @@ def effects_from_diagnosis(summary: dict) -> tuple[dict | None, str]:
     -------
     effects : dict or None
         ``{effect: {parameter: value}}`` (the calibrated candidate's parameters) when the
-        verdict is an effect with confidence ``clear``; None otherwise.
+        verdict is an effect with confidence ``clear``, or named with a remainder beyond it
+        but identified (``verdict_detail.identified``: no close rival, no range edge);
+        None otherwise.
     reason : str
         One line for the report.
     """
@@ -53,15 +55,18 @@ def effects_from_diagnosis(summary: dict) -> tuple[dict | None, str]:
     conf = summary.get("verdict_confidence", "none")
     if verdict in ("none", "unexplained", None):
         return None, f"the diagnosis answered '{verdict}': the nominal model is kept"
-    if conf != "clear":
+    identified = bool((summary.get("verdict_detail") or {}).get("identified"))
+    if conf != "clear" and not identified:
         return None, (f"the diagnosis named {verdict} with confidence '{conf}' only: the nominal model "
-                      f"is kept (a correction is made on 'clear' verdicts)")
+                      f"is kept (a correction is made on 'clear' verdicts, or where only a "
+                      f"remainder beyond the effect kept it from 'clear')")
     entry = next((r for r in summary.get("ranking", []) if r.get("effect") == verdict), None)
     if entry is None or not entry.get("parameters"):
         return None, f"the diagnosis named {verdict} but recorded no calibrated parameters: nominal model kept"
     params = {str(k): {str(p): float(v) for p, v in d.items()} for k, d in entry["parameters"].items()}
     text = ", ".join(f"{k}." + ", ".join(f"{p}={v:.4g}" for p, v in d.items()) for k, d in params.items())
-    return params, f"the diagnosis named {verdict} (confidence clear); inverted with {text}"
+    how = "confidence clear" if conf == "clear" else "identified; a difference beyond it remains"
+    return params, f"the diagnosis named {verdict} ({how}); inverted with {text}"
 
 
 def still_poor_message(fit_quality: dict, effects: dict) -> str:

@@ -102,3 +102,19 @@ def test_partial_signature_names_the_effect_but_not_clearly():
     assert "remains" in d["reason"]
     # an effect that leaves an off transmissibility as it was does not agree
     assert decide(_summary(chi2=(9.0, 9.0)))["verdict"] == "unexplained"
+
+
+def test_identified_effect_with_a_remainder_drives_the_correction():
+    from diagnosis.closed_loop import effects_from_diagnosis
+
+    s = _summary(chi2=(9.0, 5.0))
+    d = decide(s)
+    assert d["confidence"] == "ambiguous" and d["identified"] is True
+    s.update(verdict=d["verdict"], verdict_confidence=d["confidence"], verdict_detail=d)
+    eff, why = effects_from_diagnosis(s)
+    assert eff == {"leaf_friction": {"force": 4000.0}} and "remains" in why
+    # an edge calibration is not identified: no correction
+    s = _summary(force=12000.0)
+    d = decide(s)
+    s.update(verdict=d["verdict"], verdict_confidence=d["confidence"], verdict_detail=d)
+    assert d["identified"] is False and effects_from_diagnosis(s)[0] is None
