@@ -261,8 +261,11 @@ def rescore(root, **thresholds) -> dict:
     root = Path(root)
     results = []
     for r in json.loads((root / "blind.json").read_text())["results"]:
-        p = Path(r.get("summary") or root / f"case{r['case']:03d}-run" / "summary.json")
-        if not p.is_file():
+        tries = [Path(r["summary"])] if r.get("summary") else []
+        tries += [root / f"case{r['case']:03d}-run" / "summary.json",
+                  root / f"case{r['case']:03d}-summary.json"]     # an archived results folder
+        p = next((t for t in tries if t.is_file()), None)
+        if p is None:
             continue
         summ = json.loads(p.read_text())
         d = decide(summ, **thresholds)
@@ -271,6 +274,16 @@ def rescore(root, **thresholds) -> dict:
                             **judge(r, d["verdict"], d["confidence"]),
                             param_ratio=param_ratio(r, entry)))
     return {"results": results, "score": score(results)}
+
+
+def _rate(flags) -> float:
+    return float(np.mean(flags)) if flags else float("nan")
+
+
+def _family_score(rs: list[dict]) -> dict:
+    """Cases, top-1 on library-effect cases, and the right-answer rate without one."""
+    return {"n": len(rs), "effect_top1": _rate([r["correct"] for r in rs if r["effect"] != "none"]),
+            "no_effect_right": _rate([r["correct"] for r in rs if r["effect"] == "none"])}
 
 
 def score(results: list[dict]) -> dict:
@@ -304,14 +317,8 @@ def score(results: list[dict]) -> dict:
                                                  if r["correct"] and r.get("param_ratio") is not None]))
                                   if any(r["correct"] and r.get("param_ratio") is not None for r in eff)
                                   else float("nan")),
-        "by_family": {f: {"n": len(rs), "effect_top1": float(np.mean([r["correct"] for r in rs
-                                                                      if r["effect"] != "none"]))
-                          if any(r["effect"] != "none" for r in rs) else float("nan"),
-                          "no_effect_right": float(np.mean([r["correct"] for r in rs
-                                                            if r["effect"] == "none"]))
-                          if any(r["effect"] == "none" for r in rs) else float("nan")}
-                      for f in sorted({r.get("family", "nominal") for r in results})
-                      for rs in [[r for r in results if r.get("family", "nominal") == f]]},
+        "by_family": {f: _family_score([r for r in results if r.get("family", "nominal") == f])
+                      for f in sorted({r.get("family", "nominal") for r in results})},
         "confident_wrong": int(sum(r["confident_wrong"] for r in results)),
         "localisation_hit_rate": float(np.mean([r["localisation_hit"] for r in results]))
         if results else float("nan"),

@@ -646,6 +646,19 @@ def _level_logs(model, sig, sim: dict, mk) -> list:
     return logs
 
 
+def _runs_psd(meas: np.ndarray, sim: np.ndarray, runs, fs: float, nperseg: int):
+    """(f, P_meas, P_sim): Welch PSDs of the runs ``(i, j)`` of two records (each run's mean
+    removed), summed with the run lengths as weights."""
+    from scipy import signal
+
+    pm = ps = 0.0
+    for i, j in runs:
+        f, p1 = signal.welch(meas[i:j] - meas[i:j].mean(), fs=fs, nperseg=nperseg)
+        _, p2 = signal.welch(sim[i:j] - sim[i:j].mean(), fs=fs, nperseg=nperseg)
+        pm, ps = pm + p1 * (j - i), ps + p2 * (j - i)
+    return f, pm, ps
+
+
 def _low_band_log_ratio(sig: Signals, sim: dict, mask: np.ndarray, names) -> float:
     """``ln(Pm_low / Pm_ref) - ln(Ps_low / Ps_ref)``: the measured against the simulated
     share of low-band power, ``P_low`` the power in ``NMIN_LOW_BAND`` and ``P_ref`` in
@@ -654,7 +667,6 @@ def _low_band_log_ratio(sig: Signals, sim: dict, mask: np.ndarray, names) -> flo
     overlap).  Pooling matters: a third octave below 1 Hz holds one or two bins of a
     1024-sample segment, and a per-band log ratio of a 7 s run scatters by more than a
     unit (var ln of a 2-dof chi-square: pi^2/6 per side)."""
-    from scipy import signal
 
     fs = sig.fs
     runs = [(i, j) for i, j in _runs(mask) if j - i >= 512]
@@ -663,11 +675,8 @@ def _low_band_log_ratio(sig: Signals, sim: dict, mask: np.ndarray, names) -> flo
     nper = int(min(1024, min(j - i for i, j in runs)))
     pm = ps = 0.0
     for c in names:
-        for i, j in runs:
-            f, p1 = signal.welch(sig.channels[c][i:j] - sig.channels[c][i:j].mean(), fs=fs,
-                                 nperseg=nper)
-            _, p2 = signal.welch(sim[c][i:j] - sim[c][i:j].mean(), fs=fs, nperseg=nper)
-            pm, ps = pm + p1 * (j - i), ps + p2 * (j - i)
+        f, p1, p2 = _runs_psd(sig.channels[c], sim[c], runs, fs, nper)
+        pm, ps = pm + p1, ps + p2
     lo = (f >= NMIN_LOW_BAND[0]) & (f < NMIN_LOW_BAND[1])
     rf = (f >= NMIN_REF_BAND[0]) & (f < NMIN_REF_BAND[1])
     vals = [pm[lo].sum(), pm[rf].sum(), ps[lo].sum(), ps[rf].sum()]
@@ -736,8 +745,6 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
     -------
     (gq, w) : (K,) arrays [m^3], [-]
     """
-    from scipy import signal
-
     from diagnosis.bandpower import third_octave_bands
 
     T = sig.time.size / sig.fs
@@ -766,12 +773,7 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
         if runs:
             xs, ys = [], []
             for c in wchan:
-                pm = ps = 0.0
-                for i, j in runs:
-                    f, p1 = signal.welch(sig.channels[c][i:j] - sig.channels[c][i:j].mean(), fs=fs,
-                                         nperseg=256)
-                    _, p2 = signal.welch(sim[c][i:j] - sim[c][i:j].mean(), fs=fs, nperseg=256)
-                    pm, ps = pm + p1 * (j - i), ps + p2 * (j - i)
+                f, pm, ps = _runs_psd(sig.channels[c], sim[c], runs, fs, 256)
                 nz = 2.0 * model.noise.get(c, 0.0) ** 2 / fs * sum(j - i for i, j in runs)
                 _band_log_ratios(f, pm, ps, nz, bands, v * 0.1, xs, ys)
             if len(set(np.round(xs, 6))) >= 3:

@@ -7,7 +7,7 @@ in ways no library lists, and the library effect nearest to such a difference al
 shrinks the gap (on drives of the independent truth family, right and wrong effects
 reached similar shrink fractions).  This module decides from the ranking AND two
 further checks, using only what ``summary.json`` holds, so a saved summary can be
-re-decided (:func:`redecide`) with other thresholds -- how the thresholds were set on
+re-decided (:func:`decide` with its keyword thresholds) with other thresholds -- how the thresholds were set on
 one truth family and checked on the other (``benchmarks/bench_diagnosis.py``).
 
 Vocabulary
@@ -279,11 +279,6 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     # or value in doubt (a remainder beyond it does not): what a correction may use
     return dict(out, verdict=rv, confidence=conf, reason=reason,
                 identified=bool(rd.get("confidence") == "clear" and not edges))
-
-
-def redecide(summary: Mapping, **thresholds) -> dict:
-    """:func:`decide` on a saved summary with other thresholds (benchmarks)."""
-    return decide(summary, **thresholds)
 
 
 def search_ranges(candidates: Sequence) -> dict:
