@@ -80,6 +80,9 @@ BLIND_SETTINGS = dict(n_seeds=4, n_null=12, grid=4, refine=3, pairs=False, folds
 #: it also models (leaf friction, payload) or none; its null cases carry only the
 #: out-of-library differences, and "none" or "unexplained" is the right answer there.
 FAMILIES = {"nominal": ("null", tuple(STRENGTHS)), "second": ("second", ("leaf_friction", "payload"))}
+#: in the ``second`` family every ``MEASURED_EVERY``-th case (case 0, 4, 8, ...) drives the
+#: measured road profile (scenario ``second_measured``) instead of a synthetic ISO road
+MEASURED_EVERY = 4
 #: verdicts that are right where no library effect is in the truth
 NO_EFFECT_ANSWERS = ("none", "unexplained")
 
@@ -101,7 +104,8 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
     effects : sequence of str, optional
         Effects used (default all the family can carry, :data:`FAMILIES`).
     family : {"nominal", "second"}
-        Truth family (:data:`FAMILIES`); ``second`` case seeds are offset by 50000.
+        Truth family (:data:`FAMILIES`); ``second`` case seeds are offset by 50000, and
+        every :data:`MEASURED_EVERY`-th of its cases drives the measured road profile.
 
     Returns
     -------
@@ -118,7 +122,8 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
     cases, k = [], 0
     for i in range(n):
         ds_seed = 1000 * seed + 100 + i + off
-        tag = dict(family=family, scenario=scenario)
+        measured = family == "second" and i % MEASURED_EVERY == 0
+        tag = dict(family=family, scenario="second_measured" if measured else scenario)
         if i in null_at:
             cases.append(dict(case=i, seed=ds_seed, effect="none", param=None, value=None, **tag))
             continue
