@@ -1,4 +1,11 @@
-"""Archived runs: one folder per study run that can be trusted later.
+"""The run archive: one folder per run that can be trusted later.
+
+A base module: every layer (inverse, diagnosis, studies, the command line) may use
+it, and it imports nothing of theirs.  It owns the one ``run.json`` schema every
+command writes (:func:`run_info` / :func:`finish_run_info`), reads older run
+folders into that schema (:func:`normalize_info`), finds every run folder under a
+results root (:func:`list_runs`), and checks that a run's manifest lists only
+files that exist (:func:`manifest_problems`).
 
 Every study writes ``<root>/<study>/<run-id>/`` (``root`` is ``results`` by
 default)::
@@ -66,6 +73,13 @@ __all__ = [
     "git_state",
     "package_versions",
     "new_run_id",
+    "run_info",
+    "finish_run_info",
+    "write_run_json",
+    "normalize_info",
+    "manifest_rows",
+    "manifest_problems",
+    "RUN_SCHEMA",
 ]
 
 #: distributions whose versions are recorded in run.json (absent ones -> null)
@@ -78,6 +92,13 @@ SUMMARY_FILE = "summary.json"
 CONFIG_FILE = "config.toml"
 ERROR_FILE = "error.txt"
 TMP_PREFIX = ".tmp-"
+
+#: version of the run.json schema written by :func:`run_info`
+RUN_SCHEMA = 2
+
+#: manifest file names a run folder may hold (listing files relative to the run)
+MANIFEST_JSON = "manifest.json"
+MANIFEST_MD = "manifest.md"
 
 _REPO_DIR = Path(__file__).resolve().parents[1]
 
@@ -205,7 +226,7 @@ def git_state(repo: str | os.PathLike | None = None) -> dict[str, Any]:
     Parameters
     ----------
     repo : str or os.PathLike, optional
-        Folder to inspect (default: the folder containing the ``studies``
+        Folder to inspect (default: the folder containing the ``eroad``
         package, i.e. the eroad source tree of an editable install).
 
     Returns
@@ -256,6 +277,97 @@ def package_versions(names: tuple[str, ...] = VERSIONED_PACKAGES) -> dict[str, s
         except metadata.PackageNotFoundError:
             versions[name] = None
     return versions
+
+
+def host_info() -> dict[str, Any]:
+    """``{"hostname", "platform", "machine", "cpu_count"}`` of this machine."""
+    return {"hostname": socket.gethostname(), "platform": platform.platform(),
+            "machine": platform.machine(), "cpu_count": os.cpu_count()}
+
+
+def run_info(study: str, *, run_id: str = "", command: list[str] | str | None = None,
+             seed: int | None = None, overrides: list[str] | dict | None = None,
+             extra: dict | None = None, start: _dt.datetime | None = None) -> dict[str, Any]:
+    """The ``run.json`` record of a run that starts now (status ``"running"``).
+
+    Every command that writes a run folder (``invert``, ``diagnose``,
+    ``reproduce``, the studies) writes this one schema; finish it with
+    :func:`finish_run_info` and write it with :func:`write_run_json`.
+
+    Parameters
+    ----------
+    study : str
+        What made the run (``"invert"``, ``"diagnose"``, ``"reproduce"``, a study name).
+    run_id : str, optional
+        The run's id (default: filled in from the folder name when written).
+    command : list of str or str, optional
+        Command line (default ``sys.argv``).
+    seed : int, optional
+        Root seed of the run (``None``: the run draws nothing random).
+    overrides : list or dict, optional
+        Configuration overrides given by the user.
+    extra : dict, optional
+        Command-specific fields (e.g. ``{"quick": False, "workers": 2}``), kept
+        under ``"extra"`` so the shared fields keep one meaning.
+    start : datetime.datetime, optional
+        Start time (default now, UTC).
+
+    Returns
+    -------
+    dict
+        The record: ``schema, study, run_id, status, command, argv, overrides, cwd,
+        git, host, versions, seed, start_utc, end_utc, wall_s, error, extra``.
+    """
+    if command is None:
+        command = list(sys.argv)
+    start = start or _utc_now()
+    return {
+        "schema": RUN_SCHEMA,
+        "study": study,
+        "run_id": run_id,
+        "status": "running",
+        "command": command if isinstance(command, str) else shlex.join(map(str, command)),
+        "argv": None if isinstance(command, str) else [str(c) for c in command],
+        "overrides": overrides,
+        "cwd": os.getcwd(),
+        "git": git_state(),
+        "host": host_info(),
+        "versions": package_versions(),
+        "seed": seed,
+        "start_utc": _iso(start),
+        "end_utc": None,
+        "wall_s": None,
+        "error": None,
+        "extra": dict(extra or {}),
+    }
+
+
+def finish_run_info(info: dict, status: str = "complete", *, wall_s: float | None = None,
+                    error: BaseException | None = None) -> dict:
+    """Set status, end time, wall time [s] and error of a :func:`run_info` record
+    (in place; also returned)."""
+    end = _utc_now()
+    info["status"] = status
+    info["end_utc"] = _iso(end)
+    if wall_s is None:
+        try:
+            t0 = _dt.datetime.fromisoformat(str(info["start_utc"]).replace("Z", "+00:00"))
+            wall_s = (end - t0).total_seconds()
+        except (KeyError, ValueError):
+            wall_s = None
+    info["wall_s"] = None if wall_s is None else round(float(wall_s), 3)
+    if error is not None:
+        info["error"] = {"type": type(error).__name__, "message": str(error)}
+    return info
+
+
+def write_run_json(folder: str | os.PathLike, info: dict) -> Path:
+    """Write ``info`` to ``<folder>/run.json`` (atomically); an empty ``run_id``
+    becomes the folder name."""
+    folder = Path(folder)
+    if not info.get("run_id"):
+        info = {**info, "run_id": folder.name}
+    return write_json_atomic(folder / RUN_FILE, info)
 
 
 # ---------------------------------------------------------------------------
@@ -401,29 +513,8 @@ class RunArchive:
         self.data_dir.mkdir()
         self.figures_dir.mkdir()
         self.status = "running"
-        command = self.command
-        self.info = {
-            "study": self.study,
-            "run_id": self.run_id,
-            "status": self.status,
-            "command": command if isinstance(command, str) else shlex.join(map(str, command)),
-            "argv": None if isinstance(command, str) else [str(c) for c in command],
-            "overrides": self.overrides,
-            "cwd": os.getcwd(),
-            "git": git_state(),
-            "host": {
-                "hostname": socket.gethostname(),
-                "platform": platform.platform(),
-                "machine": platform.machine(),
-                "cpu_count": os.cpu_count(),
-            },
-            "versions": package_versions(),
-            "seed": self.seed,
-            "start_utc": _iso(start),
-            "end_utc": None,
-            "wall_s": None,
-            "error": None,
-        }
+        self.info = run_info(self.study, run_id=self.run_id, command=self.command,
+                             seed=self.seed, overrides=self.overrides, start=start)
         try:
             (self.path / CONFIG_FILE).write_bytes(tomli_w.dumps(_tomlable(self.config)).encode())
         except TypeError as exc:
@@ -435,12 +526,10 @@ class RunArchive:
     def __exit__(self, exc_type, exc, tb) -> bool:
         if self.status != "running":
             return False
-        end = _utc_now()
         self.status = "complete" if exc_type is None else "failed"
-        self.info.update(status=self.status, end_utc=_iso(end),
-                         wall_s=round(time.perf_counter() - self._t0, 3))
+        finish_run_info(self.info, self.status, wall_s=time.perf_counter() - self._t0,
+                        error=exc if exc_type is not None else None)
         if exc_type is not None:
-            self.info["error"] = {"type": exc_type.__name__, "message": str(exc)}
             (self.path / ERROR_FILE).write_text(
                 "".join(traceback.format_exception(exc_type, exc, tb)), encoding="utf-8")
         self._move_into_place()
@@ -477,6 +566,81 @@ class RunArchive:
 # ---------------------------------------------------------------------------
 # reading archives
 # ---------------------------------------------------------------------------
+#: what :func:`normalize_info` records for a field an older run did not record
+NOT_RECORDED = "not recorded"
+
+
+def _iso_any(value: Any) -> str | None:
+    """An ISO 8601 time in any of the forms older runs wrote -> ``...Z`` (or None)."""
+    if not value:
+        return None
+    text = str(value)
+    if len(text) == 10:         # a date only (a run that recorded no time of day)
+        return text
+    try:
+        t = _dt.datetime.fromisoformat(text.replace("Z", "+00:00"))
+    except ValueError:
+        return text
+    if t.tzinfo is None:
+        t = t.replace(tzinfo=_dt.timezone.utc)
+    return _iso(t.astimezone(_dt.timezone.utc))
+
+
+def normalize_info(info: dict, path: str | os.PathLike | None = None) -> dict:
+    """A ``run.json`` of any age in the current schema (:func:`run_info`).
+
+    Older runs wrote other names: ``eroad invert`` ``started``/``finished`` and a
+    host string, ``eroad reproduce`` ``start`` and its options at the top level,
+    and a command as a list.  They are mapped onto ``start_utc``/``end_utc``,
+    ``host.hostname``, ``extra`` and ``command``/``argv``; nothing is dropped
+    (unknown top-level keys go to ``extra``).  The file is not changed.
+
+    Parameters
+    ----------
+    info : dict
+        Content of a ``run.json``.
+    path : path, optional
+        The run folder (fills ``study`` and ``run_id`` when absent).
+
+    Returns
+    -------
+    dict
+        A new dict with every key of the schema.
+    """
+    info = dict(info)
+    out: dict[str, Any] = {"schema": info.pop("schema", 1)}
+    p = Path(path) if path is not None else None
+    out["study"] = info.pop("study", None) or (p.parent.name if p is not None else None)
+    out["run_id"] = info.pop("run_id", None) or (p.name if p is not None else None)
+    out["status"] = info.pop("status", None) or "unknown"
+    command = info.pop("command", None)
+    argv = info.pop("argv", None)
+    if isinstance(command, list):
+        argv = argv or [str(c) for c in command]
+        command = shlex.join(argv)
+    out["command"] = command
+    out["argv"] = argv
+    out["overrides"] = info.pop("overrides", None)
+    out["cwd"] = info.pop("cwd", None)
+    out["git"] = info.pop("git", None) or {"commit": None, "dirty": None}
+    host = info.pop("host", None)
+    out["host"] = {"hostname": host} if isinstance(host, str) else (host or {})
+    out["versions"] = info.pop("versions", None) or {}
+    out["seed"] = info.pop("seed", None)
+    start_utc, start, started = info.pop("start_utc", None), info.pop("start", None), \
+        info.pop("started", None)
+    end_utc, finished = info.pop("end_utc", None), info.pop("finished", None)
+    out["start_utc"] = _iso_any(start_utc or start or started)
+    out["end_utc"] = _iso_any(end_utc or finished)
+    out["wall_s"] = info.pop("wall_s", None)
+    err = info.pop("error", None)
+    out["error"] = {"type": "", "message": err} if isinstance(err, str) else err
+    extra = dict(info.pop("extra", None) or {})
+    extra.update(info)          # whatever else an older run recorded
+    out["extra"] = extra
+    return out
+
+
 @dataclass(frozen=True)
 class RunRecord:
     """One archived run as read from disk.
@@ -486,7 +650,7 @@ class RunRecord:
     path : pathlib.Path
         The run folder.
     info : dict
-        Content of ``run.json``.
+        Content of ``run.json`` in the current schema (:func:`normalize_info`).
     summary : dict or None
         Content of ``summary.json`` (``None`` if absent).
     """
@@ -497,8 +661,8 @@ class RunRecord:
 
     @property
     def study(self) -> str:
-        """Study name."""
-        return str(self.info.get("study", self.path.parent.name))
+        """Study name (the command or study that made the run)."""
+        return str(self.info.get("study") or self.path.parent.name)
 
     @property
     def run_id(self) -> str:
@@ -507,12 +671,12 @@ class RunRecord:
 
     @property
     def status(self) -> str:
-        """``"complete"``, ``"failed"`` or ``"running"``."""
+        """``"complete"``, ``"failed"``, ``"running"``, ``"partial"``, ..."""
         return str(self.info.get("status", "unknown"))
 
     @property
     def start(self) -> str:
-        """Start time, ISO 8601 UTC."""
+        """Start time, ISO 8601 UTC (``""`` if not recorded)."""
         return str(self.info.get("start_utc") or "")
 
     @property
@@ -522,85 +686,107 @@ class RunRecord:
         return None if w is None else float(w)
 
 
+def _read_json_object(p: Path) -> dict:
+    try:
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise EroadInputError(f"{p}: cannot read JSON: {exc}") from None
+    if not isinstance(data, dict):
+        raise EroadInputError(f"{p}: expected a JSON object")
+    return data
+
+
 def load_run(path: str | os.PathLike) -> RunRecord:
-    """Read an archived run folder.
+    """Read a run folder.
 
     Parameters
     ----------
     path : str or os.PathLike
-        A run folder (containing ``run.json``).
+        A run folder.  Without ``run.json`` (a folder written before runs had
+        one) the record holds only what the folder says: study and run-id from
+        its place, every other field ``"not recorded"``.
 
     Returns
     -------
     RunRecord
-        The run.
+        The run, its ``info`` in the current schema.
 
     Raises
     ------
     eroad.errors.EroadInputError
-        If the folder does not exist, has no ``run.json``, or a JSON file is
-        not valid JSON.
+        If the folder does not exist or is empty, or a JSON file is not a valid
+        JSON object.
     """
     path = Path(path)
     if not path.is_dir():
         raise EroadInputError(f"{path}: no such run folder")
     run_file = path / RUN_FILE
-    if not run_file.is_file():
-        raise EroadInputError(f"{path}: not a run folder (no {RUN_FILE})")
-
-    def read(p: Path) -> dict:
-        try:
-            data = json.loads(p.read_text(encoding="utf-8"))
-        except (OSError, json.JSONDecodeError) as exc:
-            raise EroadInputError(f"{p}: cannot read JSON: {exc}") from None
-        if not isinstance(data, dict):
-            raise EroadInputError(f"{p}: expected a JSON object")
-        return data
-
-    info = read(run_file)
+    if not run_file.is_file() and not any(path.iterdir()):
+        raise EroadInputError(f"{path}: not a run folder (empty)")
+    if run_file.is_file():
+        info = normalize_info(_read_json_object(run_file), path)
+    else:
+        info = normalize_info({"status": NOT_RECORDED, "command": NOT_RECORDED,
+                               "extra": {"note": f"no {RUN_FILE} in this folder"}}, path)
     summary_file = path / SUMMARY_FILE
-    summary = read(summary_file) if summary_file.is_file() else None
+    summary = _read_json_object(summary_file) if summary_file.is_file() else None
     return RunRecord(path=path, info=info, summary=summary)
 
 
+def _is_hidden(p: Path) -> bool:
+    return p.name.startswith(".") or p.name == "__pycache__"
+
+
 def _iter_run_dirs(root: Path) -> Iterator[Path]:
+    """Every run folder under ``root``: ``<root>/<study>/<run>/``, or ``<root>/<study>/``
+    itself when it holds ``run.json`` or no sub-folders (a study of one run).
+
+    Hidden folders (temporary ``.tmp-*`` runs) and empty folders are skipped.  Runs nested inside a
+    run (the steps of ``eroad reproduce``) belong to their parent and are not
+    listed separately.
+    """
     if not root.is_dir():
         return
     for study in sorted(root.iterdir()):
-        if not study.is_dir() or study.name.startswith("."):
+        if not study.is_dir() or _is_hidden(study):
             continue
-        for run in sorted(study.iterdir()):
-            if run.is_dir() and not run.name.startswith(".") and (run / RUN_FILE).is_file():
-                yield run
+        subdirs = [d for d in sorted(study.iterdir()) if d.is_dir() and not _is_hidden(d)]
+        if (study / RUN_FILE).is_file() or not subdirs:
+            if any(study.iterdir()):
+                yield study
+            continue
+        yield from (d for d in subdirs if any(d.iterdir()))   # an empty folder holds no run
 
 
 def list_runs(root: str | os.PathLike = "results", study: str | None = None) -> list[RunRecord]:
-    """All archived runs under ``root``, oldest first.
+    """All run folders under ``root``, oldest first.
 
     Parameters
     ----------
     root : str or os.PathLike, optional
         Results root (default ``"results"``).  A missing root gives ``[]``.
     study : str, optional
-        Only runs of this study.
+        Only runs of this study (the folder name under ``root``).
 
     Returns
     -------
     list of RunRecord
-        Sorted by start time, then study and run-id.  Hidden folders
-        (temporary ``.tmp-*`` runs still in progress or abandoned) and folders
-        without ``run.json`` are skipped; a run whose JSON is unreadable is
-        listed with status ``"unreadable"``.
+        Sorted by start time, then study and run-id.  Hidden folders (temporary
+        ``.tmp-*`` runs) are skipped; a folder without ``run.json`` is listed with
+        status ``"not recorded"``; a run whose JSON is unreadable with status
+        ``"unreadable"``.
     """
     records = []
-    for run_dir in _iter_run_dirs(Path(root)):
-        if study is not None and run_dir.parent.name != study:
+    root = Path(root)
+    for run_dir in _iter_run_dirs(root):
+        group = run_dir.name if run_dir.parent == root else run_dir.parent.name
+        if study is not None and group != study:
             continue
         try:
             records.append(load_run(run_dir))
         except EroadInputError as exc:
-            records.append(RunRecord(path=run_dir, info={"status": "unreadable",
-                                                         "error": {"message": str(exc)}}))
+            records.append(RunRecord(path=run_dir, info=normalize_info(
+                {"status": "unreadable", "error": {"type": "", "message": str(exc)}}, run_dir)))
     return sorted(records, key=lambda r: (r.start, r.study, r.run_id))
 
 
@@ -626,17 +812,97 @@ def find_run(run: str | os.PathLike, root: str | os.PathLike = "results") -> Run
         If nothing or more than one run matches.
     """
     p = Path(run)
+    dirs = list(_iter_run_dirs(Path(root)))
+    known = {d.resolve() for d in dirs}
     for candidate in (p, Path(root) / p):
-        if (candidate / RUN_FILE).is_file():
+        if candidate.is_dir() and ((candidate / RUN_FILE).is_file() or candidate.resolve() in known):
             return load_run(candidate)
     name = str(run)
-    matches = [d for d in _iter_run_dirs(Path(root)) if d.name == name]
+    matches = [d for d in dirs if d.name == name]
     if not matches:
-        matches = [d for d in _iter_run_dirs(Path(root)) if d.name.startswith(name)]
+        matches = [d for d in dirs if d.name.startswith(name)]
     if not matches:
-        raise EroadInputError(f"run {name!r}: no run folder or run-id under {root}")
+        raise EroadInputError(f"run {name!r}: no run folder or run-id under {root} "
+                              "(see `eroad runs list`)")
     if len(matches) > 1:
         shown = ", ".join(f"{d.parent.name}/{d.name}" for d in matches[:3])
         raise EroadInputError(f"run {name!r} is ambiguous under {root}: {len(matches)} runs "
                               f"match ({shown}{', ...' if len(matches) > 3 else ''})")
     return load_run(matches[0])
+
+
+# ---------------------------------------------------------------------------
+# manifests: paper item -> files relative to the run
+# ---------------------------------------------------------------------------
+def manifest_rows(run: str | os.PathLike, items) -> list[dict]:
+    """Manifest rows of the files that exist in ``run``.
+
+    Parameters
+    ----------
+    run : path
+        The run folder.
+    items : iterable of (item, pattern, code)
+        Paper item, glob pattern relative to the run (``"invert/road.*"``) and the
+        code that makes it.
+
+    Returns
+    -------
+    list of dict
+        ``{"item", "files", "code", "present"}`` with ``files`` the existing
+        matches, sorted, relative to the run (``/``-separated).
+    """
+    run = Path(run)
+    rows = []
+    for item, pattern, code in items:
+        files = sorted(p.relative_to(run).as_posix() for p in run.glob(pattern) if p.is_file())
+        rows.append({"item": item, "files": files, "code": code, "present": bool(files)})
+    return rows
+
+
+def _md_links(text: str) -> list[str]:
+    import re
+    return [m for m in re.findall(r"\]\(([^)\s]+)\)", text) if "://" not in m and not m.startswith("#")]
+
+
+def manifest_problems(run: str | os.PathLike) -> list[str]:
+    """What a run's manifest claims that its folder does not hold.
+
+    Checks ``manifest.json`` (every listed file exists, is relative to the run and
+    inside it; ``present`` says whether files are listed) and ``manifest.md``
+    (every relative link points at an existing file).
+
+    Parameters
+    ----------
+    run : path
+        The run folder.
+
+    Returns
+    -------
+    list of str
+        One line per problem; empty when the manifests agree with the folder (or
+        the run has none).
+    """
+    run = Path(run)
+    problems = []
+    mj = run / MANIFEST_JSON
+    if mj.is_file():
+        try:
+            rows = json.loads(mj.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError) as exc:
+            return [f"{mj}: cannot read JSON: {exc}"]
+        for row in rows if isinstance(rows, list) else []:
+            files = row.get("files") or []
+            for f in files:
+                if Path(f).is_absolute() or ".." in Path(f).parts:
+                    problems.append(f"{mj}: {row.get('item')}: {f} is not a path inside the run")
+                elif not (run / f).is_file():
+                    problems.append(f"{mj}: {row.get('item')}: {f} is listed but missing")
+            if "present" in row and bool(row["present"]) != bool(files):
+                problems.append(f"{mj}: {row.get('item')}: present={row['present']} "
+                                f"with {len(files)} file(s) listed")
+    md = run / MANIFEST_MD
+    if md.is_file():
+        for link in _md_links(md.read_text(encoding="utf-8")):
+            if Path(link).is_absolute() or not (run / link).exists():
+                problems.append(f"{md}: link {link} points at no file of the run")
+    return problems

@@ -1,7 +1,7 @@
-"""Commands of the ``studies`` package: ``eroad runs list|show``.
+"""``eroad runs list|show``: the run archive (:mod:`eroad.archive`) on the command line.
 
 ``eroad runs list [--root results] [--study NAME] [--json]`` prints a table of
-the archived runs (study, run-id, status, start, wall time);
+every run folder under the root (study, run-id, status, start, wall time);
 ``eroad runs show RUN [--root results] [--json]`` prints the essentials of one
 run's ``run.json`` and ``summary.json``.  RUN is a run folder, a run-id or a
 unique run-id prefix.  See ``docs/studies.md``.
@@ -12,7 +12,7 @@ import argparse
 import json
 from typing import Any
 
-from studies.runs import RunRecord, find_run, list_runs
+from eroad.archive import NOT_RECORDED, RunRecord, find_run, list_runs
 
 __all__ = ["register"]
 
@@ -110,6 +110,10 @@ def _scalar_items(d: dict, prefix: str = "") -> list[tuple[str, str]]:
     return items
 
 
+def _text(value: Any, none: str = NOT_RECORDED) -> str:
+    return none if value is None or value == "" else str(value)
+
+
 def _cmd_show(args: argparse.Namespace) -> int:
     rec = find_run(args.run, root=args.root)
     if args.json:
@@ -118,27 +122,35 @@ def _cmd_show(args: argparse.Namespace) -> int:
         return 0
     info = rec.info
     git = info.get("git") or {}
-    commit = git.get("commit") or "unknown"
-    if git.get("dirty"):
+    commit = _text(git.get("commit"))
+    dirty = git.get("dirty")
+    if dirty is True:
         commit += " (dirty)"
+    elif dirty is None or isinstance(dirty, str):
+        commit += f" (dirty: {_text(dirty)})"
     versions = info.get("versions") or {}
+    host = info.get("host") or {}
+    seed = info.get("seed")
     lines = [
         ("run", f"{rec.study}/{rec.run_id}"),
         ("path", str(rec.path)),
         ("status", rec.status),
-        ("command", str(info.get("command"))),
-        ("overrides", json.dumps(info.get("overrides"))),
-        ("seed", str(info.get("seed"))),
+        ("command", _text(info.get("command"))),
+        ("overrides", _text(info.get("overrides") and json.dumps(info["overrides"]), "none")),
+        ("seed", _text(seed, "none (the run draws nothing random)")),
         ("git", commit),
-        ("host", str((info.get("host") or {}).get("hostname"))),
-        ("versions", ", ".join(f"{k} {v}" for k, v in versions.items() if v)),
-        ("start", str(info.get("start_utc"))),
-        ("end", str(info.get("end_utc"))),
-        ("wall", _fmt_wall(rec.wall_s)),
+        ("host", _text(host.get("hostname"))),
+        ("versions", ", ".join(f"{k} {v}" for k, v in versions.items() if v) or NOT_RECORDED),
+        ("start", _text(info.get("start_utc"))),
+        ("end", _text(info.get("end_utc"), "-" if rec.status == "running" else NOT_RECORDED)),
+        ("wall", _fmt_wall(rec.wall_s) if rec.wall_s is not None else NOT_RECORDED),
     ]
     err = info.get("error")
     if err:
         lines.append(("error", f"{err.get('type', '')}: {err.get('message', '')}".strip(": ")))
+    for key, val in (info.get("extra") or {}).items():
+        if not isinstance(val, (dict, list)) and val is not None:
+            lines.append((key, str(val)))
     width = max(len(k) for k, _ in lines)
     for key, val in lines:
         print(f"{key.ljust(width)}  {val}")
