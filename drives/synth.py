@@ -70,6 +70,8 @@ TRUTH_MODELS = ("exudyn", "independent")
 PROFILE_DIR = Path(__file__).with_name("data")
 #: lateral shift [m] between the two ends of the measured-profile road (build_profile_road)
 PROFILE_SHIFT_M = 40.0
+#: sub-folder of a windowed scenario's dataset holding the whole record (a dataset itself)
+RECORD_DIR = "record"
 #: road beyond the vehicle at both ends of the simulated run [m]
 ROAD_MARGIN_M = 10.0
 #: where ``default_dataset`` caches the embedded dataset (env EROAD_CACHE overrides)
@@ -80,7 +82,8 @@ DEFAULT_SCENARIO, DEFAULT_SEED = "luliang", 0
 #: allowed keys per table of a scenario file
 _KEYS = {
     "scenario": {"name", "dataset_name", "description", "vehicle", "duration_s",
-                 "sample_rate_hz", "start_time_s", "runin_s", "reference_axle", "seed"},
+                 "sample_rate_hz", "start_time_s", "runin_s", "reference_axle", "seed",
+                 "window_s"},
     "speed": {"kind", "min_mps", "max_mps", "knot_spacing_s", "exact_range", "t_s", "v_mps"},
     "road": {"dx_m", "dy_m", "width_m", "lam", "segments", "random", "profile"},
     "road.random": {"n_segments", "classes", "w", "nmin", "nmax", "min_segment_s"},
@@ -270,7 +273,10 @@ def resolve_scenario(cfg: dict, seed: int | None = None, *, effects=(), vehicle=
     if "vehicle" in sc and str(sc["vehicle"]).endswith(".toml"):
         sc["vehicle"] = str(Path(sc["vehicle"]).resolve())  # the explicit scenario works anywhere
     if duration is not None:
-        sc["duration_s"] = float(duration)
+        if "window_s" in sc:   # a windowed scenario: --duration is the window's (the dataset's)
+            sc["window_s"] = [float(sc["window_s"][0]), float(sc["window_s"][0]) + float(duration)]
+        else:
+            sc["duration_s"] = float(duration)
     for key, default in (("duration_s", None), ("sample_rate_hz", 200.0), ("start_time_s", 0.0),
                          ("runin_s", 2.0), ("reference_axle", 3), ("vehicle", "dump_truck_8x4"),
                          ("name", "custom"), ("dataset_name", "synth-{seed}"), ("description", "")):
@@ -288,6 +294,8 @@ def resolve_scenario(cfg: dict, seed: int | None = None, *, effects=(), vehicle=
                               "number of samples")
     sc["dataset_name"] = str(sc["dataset_name"]).replace("{seed}", str(seed))
     runin = float(sc["runin_s"])
+    if "window_s" in sc:
+        _check_window(sc, src)
 
     sp = cfg["speed"]
     if "t_s" not in sp:
@@ -363,6 +371,58 @@ def resolve_scenario(cfg: dict, seed: int | None = None, *, effects=(), vehicle=
         if not (isinstance(noise[key], (int, float)) and noise[key] >= 0):
             raise EroadInputError(f"{src}: [noise] {key} must be a number >= 0")
     return cfg
+
+
+def _check_window(sc: dict, src) -> None:
+    """``[scenario] window_s = [T0, T1]``: inside the record, whole samples from its start."""
+    w = sc["window_s"]
+    if not (isinstance(w, (list, tuple)) and len(w) == 2
+            and all(isinstance(v, (int, float)) for v in w)):
+        raise EroadInputError(f"{src}: [scenario] window_s must be two numbers [T0, T1] in s")
+    t0, t1 = float(w[0]), float(w[1])
+    start, T, fs = float(sc["start_time_s"]), float(sc["duration_s"]), float(sc["sample_rate_hz"])
+    if not (start - 1e-9 <= t0 < t1 <= start + T + 1e-9):
+        raise EroadInputError(f"{src}: window {t0:g}-{t1:g} s must lie inside the record "
+                              f"{start:g}-{start + T:g} s (with --duration: the window's length)")
+    for v in ((t0 - start) * fs, (t1 - t0) * fs):
+        if abs(v - round(v)) > 1e-6:
+            raise EroadInputError(f"{src}: window {t0:g}-{t1:g} s must start and end on the "
+                                  f"record's {fs:g} Hz sample grid")
+    sc["window_s"] = [t0, t1]
+
+
+def window_segments(segments: list, window, x_of_t) -> list:
+    """The segments of a record clipped to a window (what the window's truth lists).
+
+    Parameters
+    ----------
+    segments : list of dict
+        Record segments with ``t_start, t_end`` [s] (record time axis) and ``x_start, x_end``.
+    window : (float, float)
+        [s] on the same axis.
+    x_of_t : callable
+        Road x [m] of the reference axle at a time on that axis.
+
+    Returns
+    -------
+    list of dict
+        Segments overlapping the window, times and positions clipped to it,
+        ``proportion`` and ``duration_s`` of the window, ``record_segment`` (1-based).
+    """
+    t0, t1 = float(window[0]), float(window[1])
+    out = []
+    for i, s in enumerate(segments):
+        if s["t_end"] <= t0 or s["t_start"] >= t1:
+            continue
+        d = dict(s, record_segment=i + 1)
+        if s["t_start"] < t0:
+            d["t_start"], d["x_start"] = t0, float(x_of_t(t0))
+        if s["t_end"] > t1:
+            d["t_end"], d["x_end"] = t1, float(x_of_t(t1))
+        d["duration_s"] = d["t_end"] - d["t_start"]
+        d["proportion"] = d["duration_s"] / (t1 - t0)
+        out.append(d)
+    return out
 
 
 def _parse_effect_items(items) -> dict:
@@ -730,6 +790,23 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
         d["dx_m"] = float(cfg["road"]["dx_m"])
         d["dy_m"] = float(cfg["road"]["dy_m"])
         segments.append(d)
+    # a windowed scenario (luliang): the dataset is the window cut from the record (the same
+    # samples and noise); the whole record goes to record/, a dataset of its own
+    window = sc.get("window_s")
+    record_noisy, record_segments, n_ds, ds_start = noisy, segments, n_rec, start
+    if window is not None:
+        i0 = int(round((float(window[0]) - start) * fs))
+        n_ds = int(round((float(window[1]) - float(window[0])) * fs))
+        ds_start = float(window[0])
+
+        def cut(df):   # the window's rows; time written as the dataset's own grid
+            w = df.iloc[i0:i0 + n_ds].reset_index(drop=True).copy()
+            w["time"] = ds_start + np.arange(n_ds) / fs
+            return w
+
+        clean, noisy = cut(clean), cut(noisy)
+        segments = window_segments(record_segments, window,
+                                   lambda t: np.interp(t - start, plan["t_rec"], plan["x_ref"]))
     sim_meta = {k: v for k, v in dict(getattr(res, "meta", {}) or {}).items() if not _VOLATILE.search(k)}
     truth = {
         "generator": "eroad synth (drives.synth)",
@@ -739,7 +816,7 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
                     "road_seed": _int_seed(seed, STREAM_ROAD),
                     "noise": [seed, STREAM_NOISE, "crc32(channel)"],
                     "vehicle_seed": _int_seed(seed, STREAM_VEHICLE)},
-        "record": {"start_time_s": start, "duration_s": n_rec / fs, "sample_rate_hz": fs,
+        "record": {"start_time_s": ds_start, "duration_s": n_ds / fs, "sample_rate_hz": fs,
                    "runin_s": n_run / fs, "reference_axle": int(sc["reference_axle"])},
         "segments": segments,
         "junctions": road.meta.get("junctions", []),
@@ -754,15 +831,22 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
         "noise": cfg["noise"],
         "made_by": src,
     }
+    if window is not None:
+        truth["whole_record"] = {"folder": RECORD_DIR, "start_time_s": start,
+                                 "duration_s": n_rec / fs, "window_s": list(window),
+                                 "segments": record_segments}
     truth = _jsonable(truth)
     summary = {
         "scenario": sc["name"], "seed": seed, "dataset_name": sc["dataset_name"],
-        "duration_s": n_rec / fs, "sample_rate_hz": fs, "channels": list(noisy.columns[1:]),
+        "duration_s": n_ds / fs, "sample_rate_hz": fs, "channels": list(noisy.columns[1:]),
         "speed_range_mps": [truth["speed"]["min_mps"], truth["speed"]["max_mps"]],
         "segments": [{k: s[k] for k in ("t_start", "t_end", "proportion", "Gq_n0", "w", "nmin",
                                          "nmax", "label", "x_start", "x_end")} for s in segments],
         "effects": cfg["truth"]["effects"], "chassis": cfg["truth"]["chassis"],
     }
+    if window is not None:
+        summary["record_s"] = [start, start + n_rec / fs]
+        summary["window_s"] = list(window)
 
     def add_truth(tmp: Path):
         import tomli_w
@@ -777,9 +861,19 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
         mode = 0o666 & ~_umask()
         for f in td.iterdir():
             os.chmod(f, mode)
+        if window is not None:
+            rmeta = dict(meta, name=f"{sc['name']}-record-{start:g}-{start + n_rec / fs:g}",
+                         start_time_s=start,
+                         description=(f"virtual test drive (eroad synth), the whole record; the "
+                                      f"dataset one folder up is its {window[0]:g}-{window[1]:g} s "
+                                      "window"))
+            write_drive(tmp / RECORD_DIR, record_noisy, rmeta, vehicle_file=vfile)
 
-    meta = {"name": sc["dataset_name"], "sample_rate_hz": fs, "start_time_s": start,
+    meta = {"name": sc["dataset_name"], "sample_rate_hz": fs, "start_time_s": ds_start,
             "description": "virtual test drive (eroad synth); what made it is in truth/"}
+    if window is not None:
+        meta["description"] = (f"virtual test drive (eroad synth), the {window[0]:g}-{window[1]:g} s "
+                               f"window of the record in {RECORD_DIR}/; what made it is in truth/")
     vfile = None
     vpath = Path(str(sc["vehicle"]))
     if vpath.suffix == ".toml" and vpath.is_file():
@@ -859,12 +953,24 @@ def read_truth(dataset) -> dict:
     return truth
 
 
+def _scenario_key() -> str:
+    """Ten hex digits of the default scenario as resolved: the cache folder's name carries
+    it, so a changed scenario file is never served from a stale cache."""
+    import hashlib
+
+    import tomli_w
+
+    cfg, path = load_scenario(DEFAULT_SCENARIO)
+    text = tomli_w.dumps(_jsonable(resolve_scenario(cfg, DEFAULT_SEED, src=path)))
+    return hashlib.sha256(text.encode()).hexdigest()[:10]
+
+
 def default_dataset(path=None) -> Path:
     """The embedded default dataset (``eroad synth --scenario luliang --seed 0``).
 
-    Generated on first use into ``path`` (default ``$EROAD_CACHE/datasets/luliang-seed0``
-    or ``~/.cache/eroad/datasets/luliang-seed0``) and reused afterwards when it
-    is a valid dataset.
+    Generated on first use into ``path`` (default ``$EROAD_CACHE/datasets/luliang-seed0-KEY``
+    or ``~/.cache/eroad/datasets/luliang-seed0-KEY``, KEY a hash of the resolved scenario)
+    and reused afterwards when it is a valid dataset.
 
     Parameters
     ----------
@@ -878,7 +984,7 @@ def default_dataset(path=None) -> Path:
     """
     if path is None:
         root = Path(os.environ.get("EROAD_CACHE", DEFAULT_CACHE))
-        path = root / "datasets" / f"{Path(DEFAULT_SCENARIO).stem}-seed{DEFAULT_SEED}"
+        path = root / "datasets" / f"{Path(DEFAULT_SCENARIO).stem}-seed{DEFAULT_SEED}-{_scenario_key()}"
     path = Path(path)
     if (path / TRUTH_DIR / "summary.json").is_file():
         read_drive(path)  # raises with one line if the cache was damaged

@@ -57,26 +57,42 @@ MANIFEST = [
 
 
 def _step_dataset(run: Path, quick: bool, workers: int, log) -> dict:
-    """Copy the embedded dataset (without ``truth/``) into the run."""
-    from drives.synth import default_dataset
+    """Copy the embedded dataset (without ``truth/``) into the run: the 460-490 s window
+    that the inversion and the diagnosis read, and its whole record (``dataset/record/``)
+    that Figures 4 and 5 show it in."""
+    from drives.synth import RECORD_DIR, default_dataset
 
     src = default_dataset()
     dst = run / "dataset"
     dst.mkdir()
-    for name in ("channels.csv", "meta.toml", "vehicle.toml"):
-        if (src / name).is_file():
-            shutil.copy2(src / name, dst / name)
+    for sub in ("", RECORD_DIR):
+        if sub and not (src / sub).is_dir():
+            continue
+        (dst / sub).mkdir(exist_ok=True)
+        for name in ("channels.csv", "meta.toml", "vehicle.toml"):
+            if (src / sub / name).is_file():
+                shutil.copy2(src / sub / name, dst / sub / name)
     return {"source": str(src), "path": str(dst),
+            "record": str(dst / RECORD_DIR) if (dst / RECORD_DIR).is_dir() else None,
             "regenerate": "eroad synth --scenario luliang --seed 0 --out DIR"}
 
 
 def _step_fig4_5(run: Path, quick: bool, workers: int, log) -> dict:
+    """Figures 4 and 5: the window in its whole record (the window alone when the dataset
+    has no ``record/``)."""
     from drives.figures import plot_figures
     from drives.format import read_drive
+    from drives.synth import RECORD_DIR
 
     out = run / "fig4_5"
     out.mkdir()
-    summary = plot_figures(read_drive(run / "dataset"), out)
+    win = read_drive(run / "dataset")
+    rec = run / "dataset" / RECORD_DIR
+    if rec.is_dir():
+        summary = plot_figures(read_drive(rec), out,
+                               window=(float(win.time[0]), float(win.time[-1]) + win.dt))
+    else:
+        summary = plot_figures(win, out)
     return _jsonable(summary)
 
 

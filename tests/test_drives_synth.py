@@ -86,27 +86,112 @@ def short_ds(tmp_path_factory, short_cfg) -> Path:
 
 # ----------------------------------------------------------------- scenarios (no simulation)
 
-def test_luliang_is_the_papers_window():
-    """Issue 4 item 3: 30 s at 200 Hz, five segments in Table 1's time proportions with
-    Gq(n0) inside the issue's ranges, the paper's nmin, nmax, w; speed spans exactly
-    7.86-11.28 m/s (to 1e-6 m/s at the 200 Hz samples: the knots are rescaled on a
-    20001-point grid, PCHIP is smooth, so the sampled extremes differ by < 1e-6)."""
+PAPER_TABLE1 = [0.4208, 0.0470, 0.3728, 0.0292, 0.1302]
+
+
+def test_luliang_is_the_papers_window_in_a_longer_record():
+    """Issue 4 item 3 and issue 16 item 4: a 180 s record (400-580 s) at 200 Hz whose
+    460-490 s window holds five segments in Table 1's time proportions, with Gq(n0) inside
+    the issue's ranges and the paper's nmin, nmax, w; the record has an asphalt part (A)
+    before the window and another (A or B) after the loess part (C, D); speed spans exactly
+    7.86-11.28 m/s in the window (knots at the extremes) and more outside it."""
+    from roadlib.psd import class_of
+
     cfg, _ = synth.load_scenario("luliang")
     r = synth.resolve_scenario(cfg, 0)
     sc = r["scenario"]
-    assert (sc["duration_s"], sc["sample_rate_hz"], sc["vehicle"]) == (30.0, 200.0, "dump_truck_8x4")
+    assert (sc["duration_s"], sc["start_time_s"], sc["window_s"]) == (180.0, 400.0, [460.0, 490.0])
+    assert (sc["sample_rate_hz"], sc["vehicle"]) == (200.0, "dump_truck_8x4")
     segs = r["road"]["segments"]
-    np.testing.assert_allclose([s["proportion"] for s in segs],
-                               [0.4208, 0.0470, 0.3728, 0.0292, 0.1302], atol=1e-12)
+    # record segment boundaries on the record's time axis, clipped to the window
+    bounds = 400.0 + 180.0 * np.concatenate([[0.0], np.cumsum([s["proportion"] for s in segs])])
+    clipped = np.clip(bounds, 460.0, 490.0)
+    share = np.diff(clipped) / 30.0
+    inside = share > 0
+    np.testing.assert_allclose(share[inside], PAPER_TABLE1, atol=1e-9)
+    win = [s for s, k in zip(segs, inside) if k]
     ranges = [(8, 32), (128, 512), (128, 512), (512, 2048), (512, 2048)]
-    for s, (lo, hi) in zip(segs, ranges):
+    for s, (lo, hi) in zip(win, ranges):
         assert lo * 1e-6 <= s["Gq_n0"] <= hi * 1e-6
-    assert [s["nmin"] for s in segs] == [0.1, 0.01, 0.1, 0.05, 0.1]
-    assert [s["nmax"] for s in segs] == [5.0] * 5
-    assert [s["w"] for s in segs] == [2.0, 2.0, 1.8, 1.8, 1.6]
+    assert [s["nmin"] for s in win] == [0.1, 0.01, 0.1, 0.05, 0.1]
+    assert [s["nmax"] for s in win] == [5.0] * 5
+    assert [s["w"] for s in win] == [2.0, 2.0, 1.8, 1.8, 1.6]
+    # asphalt before the window (the window's A segment reaches back), loess, asphalt again
+    classes = [class_of(s["Gq_n0"]) for s in segs]
+    assert classes[0] == "A" and bounds[1] - bounds[0] > 60.0
+    assert classes[-1] in ("A", "B") and bounds[-1] - bounds[-2] > 30.0
+    assert set(classes[1:-1]) <= {"C", "D"} and bounds[-2] > 500.0
     assert r["truth"]["chassis"] == "flexible" and "leaf_friction" in r["truth"]["effects"]
-    v = synth._speed_samples(r, np.arange(6000) / 200.0)
-    assert abs(v.min() - 7.86) < 1e-6 and abs(v.max() - 11.28) < 1e-6
+    v = synth._speed_samples(r, np.arange(60 * 200, 90 * 200) / 200.0)
+    assert abs(v.min() - 7.86) < 1e-9 and abs(v.max() - 11.28) < 1e-9
+    v_all = synth._speed_samples(r, np.arange(-400, 180 * 200) / 200.0)
+    assert v_all.max() > 12.0 and v_all.min() >= 7.86 - 1e-9
+
+
+def test_window_is_cut_from_the_record(tmp_path, short_cfg):
+    """A windowed scenario: the dataset is the window's rows of record/ (same samples, same
+    noise), record/ is a valid dataset of its own, the truth's segments are the record's
+    clipped to the window with proportions of the window, and --duration sets the
+    window's length (the same drive: its rows equal the longer window's first rows)."""
+    cfg = tmp_path / "win.toml"
+    cfg.write_text(short_cfg.read_text().replace("start_time_s = 100.0",
+                                                 "start_time_s = 100.0\nwindow_s = [101.0, 102.5]"))
+    out = tmp_path / "d"
+    assert main(["synth", "--config", str(cfg), "--seed", "3", "--out", str(out)]) == 0
+    w, rec = read_drive(out), read_drive(out / synth.RECORD_DIR)
+    assert check_drive(out / synth.RECORD_DIR) == []
+    assert (w.n_samples, rec.n_samples) == (300, 600)
+    assert w.time[0] == 101.0 and rec.time[0] == 100.0
+    cut = rec.window(101.0, 102.5)
+    np.testing.assert_array_equal(w.channels.to_numpy(), cut.channels.to_numpy())
+    np.testing.assert_array_equal(w.speed, cut.speed)
+    np.testing.assert_allclose(w.time, cut.time, rtol=0, atol=1e-9)
+    truth = synth.read_truth(out)
+    whole = truth["whole_record"]
+    assert (whole["start_time_s"], whole["duration_s"], whole["window_s"]) == (100.0, 3.0, [101.0, 102.5])
+    segs = truth["segments"]
+    assert segs[0]["t_start"] == 101.0 and segs[-1]["t_end"] == 102.5
+    assert sum(s["proportion"] for s in segs) == pytest.approx(1.0)
+    for s in segs:
+        r = whole["segments"][s["record_segment"] - 1]
+        assert r["t_start"] <= s["t_start"] < s["t_end"] <= r["t_end"]
+        assert s["duration_s"] == pytest.approx(s["t_end"] - s["t_start"])
+    assert truth["record"]["start_time_s"] == 101.0 and truth["record"]["duration_s"] == 1.5
+    clean = pd.read_csv(out / "truth" / "channels_clean.csv")
+    assert len(clean) == 300 and clean["time"].iloc[0] == 101.0
+    short = tmp_path / "d1"
+    assert main(["synth", "--config", str(cfg), "--seed", "3", "--duration", "0.5",
+                 "--out", str(short)]) == 0
+    s1 = read_drive(short)
+    assert s1.n_samples == 100 and read_drive(short / synth.RECORD_DIR).n_samples == 600
+    np.testing.assert_array_equal(s1.channels.to_numpy(), w.channels.to_numpy()[:100])
+
+
+@pytest.mark.parametrize("window, msg", [("[99.0, 101.0]", "inside the record"),
+                                         ("[101.0, 104.0]", "inside the record"),
+                                         ("[101.001, 102.0]", "sample grid"),
+                                         ("[102.0, 101.0]", "inside the record"),
+                                         ('"x"', "two numbers")])
+def test_bad_window_refused(tmp_path, short_cfg, window, msg):
+    cfg = tmp_path / "win.toml"
+    cfg.write_text(short_cfg.read_text().replace("start_time_s = 100.0",
+                                                 f"start_time_s = 100.0\nwindow_s = {window}"))
+    c, path = synth.load_scenario(cfg)
+    with pytest.raises(EroadInputError, match=msg):
+        synth.resolve_scenario(c, 0, src=path)
+
+
+def test_default_dataset_cache_is_keyed_by_the_scenario(tmp_path, monkeypatch, short_cfg):
+    """The cache folder's name carries a hash of the resolved default scenario, so an edited
+    scenario file is not served from the folder the old one made."""
+    monkeypatch.setattr(synth, "DEFAULT_SCENARIO", str(short_cfg))
+    k1 = synth._scenario_key()
+    other = tmp_path / "other.toml"
+    other.write_text(short_cfg.read_text().replace("Gq_n0 = 64e-6", "Gq_n0 = 65e-6"))
+    monkeypatch.setattr(synth, "DEFAULT_SCENARIO", str(other))
+    assert synth._scenario_key() != k1
+    monkeypatch.setattr(synth, "DEFAULT_SCENARIO", str(short_cfg))
+    assert synth._scenario_key() == k1
 
 
 def test_time_proportions_become_road_lengths():
@@ -437,5 +522,12 @@ def test_luliang_default_regenerates_bit_for_bit(tmp_path):
     assert p == b
     assert files_digest(a) == files_digest(b)
     d = read_drive(a)
-    assert d.n_samples == 6000 and d.duration_s == pytest.approx(30.0)
-    assert math.isclose(synth.read_truth(a)["speed"]["min_mps"], 7.86, abs_tol=1e-6)
+    assert d.n_samples == 6000 and d.duration_s == pytest.approx(30.0) and d.time[0] == 460.0
+    rec = read_drive(a / synth.RECORD_DIR)
+    assert rec.n_samples == 36000 and rec.time[0] == 400.0
+    np.testing.assert_array_equal(d.channels.to_numpy(), rec.window(460.0, 490.0).channels.to_numpy())
+    truth = synth.read_truth(a)
+    assert math.isclose(truth["speed"]["min_mps"], 7.86, abs_tol=1e-6)
+    assert [s["label"] for s in truth["segments"]] == ["A", "C", "C", "D", "D"]
+    np.testing.assert_allclose([s["proportion"] for s in truth["segments"]], PAPER_TABLE1,
+                               atol=0.002)   # junctions sit half-way between road grid points

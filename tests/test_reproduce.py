@@ -176,3 +176,18 @@ def test_quick_reproduce_produces_every_paper_item(tmp_path):
     assert run["status"] == "complete"
     # nothing of the synthetic truth is copied into the run
     assert not (out / "dataset" / "truth").exists()
+
+
+def test_figures_4_5_show_the_window_in_its_record(partial_run):
+    """Figures 4-5 are drawn from the whole record (dataset/record/, minutes long) with the
+    460-490 s window marked; the dataset the inversion reads is the window alone."""
+    from drives.format import read_drive
+
+    s = json.loads((partial_run / "summary.json").read_text())["steps"]["fig4_5"]
+    assert s["window_s"] == [460.0, 490.0]
+    assert s["welch_averages"]["record"] > 3 * s["welch_averages"]["window"]
+    assert s["rms_record"] != s["rms_window"]
+    win = read_drive(partial_run / "dataset")
+    rec = read_drive(partial_run / "dataset" / "record")
+    assert (win.time[0], win.duration_s) == (460.0, 30.0)
+    assert rec.duration_s >= 120.0 and rec.time[0] < 460.0 and rec.time[-1] >= 490.0
