@@ -36,25 +36,42 @@ def register(subparsers) -> None:
     p.add_argument("--quick", action="store_true",
                    help="smoke-test settings: 4 candidates, fewer seeds, shorter search, no pairs")
     p.add_argument("--json", action="store_true", help="print summary.json's verdict part as JSON")
+    p.add_argument("--quiet", action="store_true", help="no progress bar or progress lines")
     p.add_argument("--force", action="store_true", help="replace an existing RUN folder")
     p.set_defaults(func=run)
+
+
+def _silent(message: str) -> None:
+    pass
+
+
+def _to_stderr(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
 
 
 def run(args) -> int:
     from diagnosis.pipeline import diagnose
     from eroad.errors import EroadInputError
+    from eroad.progress import MessageCounter, progress_bar, wants_progress
 
     effects = None
     if args.effects:
         effects = [e.strip() for e in args.effects.split(",") if e.strip()]
     if args.workers < 1:
         raise EroadInputError(f"--workers must be >= 1, got {args.workers}")
-    progress = (lambda msg: print(msg, file=sys.stderr, flush=True)) if args.json else None
-    kw = {"progress": progress} if progress else {}
-    summary = diagnose(args.dataset, args.out, vehicle=args.vehicle, effects=effects,
-                       workers=args.workers, quick=args.quick, force=args.force, seed=args.seed,
-                       road_fit=args.road_fit, settings=None if args.folds is None else {"folds": args.folds},
-                       **kw)
+    show = wants_progress(args)
+    with progress_bar(show, desc="diagnose") as bar:
+        if show:     # the bar counts candidate calibrations; the stage lines print above it
+            say = MessageCounter(bar, total_pattern=r"calibrating (\d+) candidates",
+                                 step_pattern=r"^\s+\S+: held-out gap", echo=True)
+        elif args.quiet or args.json:
+            say = _silent
+        else:
+            say = _to_stderr
+        summary = diagnose(args.dataset, args.out, vehicle=args.vehicle, effects=effects,
+                           workers=args.workers, quick=args.quick, force=args.force, seed=args.seed,
+                           road_fit=args.road_fit,
+                           settings=None if args.folds is None else {"folds": args.folds}, progress=say)
     if args.json:
         best = summary["ranking"][0] if summary.get("ranking") else None
         print(json.dumps({"verdict": summary["verdict"],
@@ -64,4 +81,7 @@ def run(args) -> int:
                               "effect", "parameters", "heldout_gap_before", "heldout_gap_after",
                               "shrink_fraction", "accepted")},
                           "out": str(args.out)}, indent=1))
+    else:
+        print(f"wrote {args.out}: verdict {summary['verdict']} ({summary.get('verdict_confidence')}); "
+              f"{summary.get('verdict_reason')}")
     return 0

@@ -13,7 +13,7 @@ and the report says why no correction was made: a correction the data do not sin
 would replace one model error by another.
 
 What it is not: a diagnosis or an inversion of its own; it calls
-:func:`diagnosis.pipeline.diagnose` and :func:`inverse.cli.run_inversion`, and writes::
+:func:`diagnosis.pipeline.diagnose` and :func:`inverse.run.run_inversion`, and writes::
 
     RUN/                 the chosen inversion's run folder (summary.json, tables, figures, road)
     RUN/diagnose/        the diagnosis (report.md, summary.json, figures)
@@ -104,13 +104,13 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     ----------
     dataset, out : str or Path
         Dataset folder; run folder to create (refused if non-empty unless ``force``).
-    workers, seed, quick : see :func:`inverse.cli.run_inversion`.
+    workers, seed, quick : see :func:`inverse.run.run_inversion`.
     diagnosis : str or Path, optional
         An existing diagnosis run folder of this dataset to use instead of diagnosing again.
     progress : callable
         One-line progress messages.
     **inversion
-        Further keyword arguments of :func:`inverse.cli.run_inversion` (not ``effects``).
+        Further keyword arguments of :func:`inverse.run.run_inversion` (not ``effects``).
 
     Returns
     -------
@@ -119,9 +119,10 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     """
     from diagnosis.pipeline import diagnose
     from drives.format import swap_into_place, temp_folder_beside
-    from inverse.cli import _check_out, run_inversion
+    from eroad.archive import write_json_atomic
     from inverse.report import write_table
-    from studies.runs import write_json_atomic
+    from inverse.run import check_out as _check_out
+    from inverse.run import dataset_path, relocate, run_inversion
 
     if "effects" in inversion:
         raise EroadInputError("--effects auto and explicit --effect values cannot be combined")
@@ -164,8 +165,12 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
         write_table(compare_table(nominal["segments"], chosen["segments"] if effects else []),
                     main / "tables" / "table1_nominal_vs_corrected",
                     note=f"Closed loop: {reason}.")
+        chosen.setdefault("dataset", {})["path"] = dataset_path(dataset, out)
         write_json_atomic(main / "summary.json", chosen)
         swap_into_place(main, out)
+        relocate(out, dataset)
+        if (out / "nominal").is_dir():
+            relocate(out / "nominal", dataset)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return chosen

@@ -67,6 +67,7 @@ from pathlib import Path
 import numpy as np
 
 from diagnosis.signals import Signals, as_signals
+from eroad.archive import finish_run_info, run_info, write_run_json
 from eroad.errors import EroadInputError
 
 #: ISO 8608 road shape kept fixed by the cheap road fit
@@ -1049,6 +1050,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     from vehicles.params import load_vehicle
 
     wall0 = _time.perf_counter()
+    record = run_info("diagnose", seed=seed, extra={"quick": bool(quick), "workers": int(workers)})
     out = Path(out)
     if out.exists() and any(out.iterdir()) and not force:
         raise EroadInputError(f"{out}: exists and is not empty (use --force to replace it)")
@@ -1147,6 +1149,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     }
     write_report(out, localization=loc, transmissibility=tr, front_rear=fr, shape=sh,
                  ranking=ranking, meta=meta, force=force, signature=sig_w)
+    write_run_json(out, finish_run_info(record, "complete", wall_s=_time.perf_counter() - wall0))
     summary = json.loads((out / "summary.json").read_text())
     progress(f"verdict: {summary['verdict']} ({summary['verdict_confidence']}); "
              f"{summary['verdict_reason']}")

@@ -1,0 +1,349 @@
+"""One inversion run: a measured drive in, a run folder out (what ``eroad invert`` runs).
+
+What this module is for: :func:`run_inversion` wires the dataset reader, the truck
+simulator (``inverse.truck``), the pipeline (``inverse.pipeline``), the
+realisation selection (``inverse.realisation``) and the report writer
+(``inverse.report``) into one run folder, and records it with the run archive
+(:mod:`eroad.archive`).  It reads the dataset's channels, speed and meta only --
+never ``truth/``.  What it is not: the command line (``inverse.cli`` parses the
+options and prints) or the method (``inverse.pipeline``).
+
+RUN (written into a temporary sibling folder and renamed into place when
+complete; an existing non-empty RUN is refused unless ``force``)::
+
+    summary.json        segments (Table 1 rows), response errors (Table 2), selection, fit, history
+    config.toml         the resolved settings
+    run.json            the archive's record (eroad.archive.run_info): command, git, versions, host,
+                        seed, start/end, status
+    history.json        the fit's iteration history
+    tables/table1.{csv,md}, tables/table2.{csv,md}, tables/candidates.csv
+    figures/figure6_segmentation, figure8_time_compare, figure9_amplitude_distributions (.png, .pdf)
+    road.npz, road.crg  the global road: fitted segments, smoothed junctions, selected phases
+
+Paths recorded in the run (the dataset) are relative to the run folder.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import time as _time
+from pathlib import Path
+
+import numpy as np
+
+from eroad.archive import finish_run_info, run_info, write_json_atomic, write_run_json
+from eroad.errors import EroadInputError
+
+__all__ = ["run_inversion", "fit_channels", "noise_psd_from_sd", "check_out", "headline",
+           "AXLE3_CHANNELS", "RUN_FORMAT"]
+
+#: run-folder format version
+RUN_FORMAT = 1
+
+
+def noise_psd_from_sd(noise_sd: dict, channels, fs: float, src: str = "--noise") -> dict:
+    """White-noise PSDs [unit^2/Hz] = sd^2 / (fs / 2) per channel from sd per channel or quantity.
+
+    A key matches a channel by its full name or by its quantity (the name without the
+    station suffix, e.g. ``axle_acc`` for ``axle_acc_3L``); a key that matches no
+    channel is refused.
+    """
+    out = {}
+    for key, sd in noise_sd.items():
+        hit = [c for c in channels if c == key or c.rsplit("_", 1)[0] == key]
+        if not hit:
+            raise EroadInputError(f"{src} {key}: matches no channel of the drive "
+                                  f"({', '.join(sorted(channels))})")
+        for c in hit:
+            out[c] = float(sd) ** 2 / (0.5 * fs)
+    return out
+
+
+#: the default fitted channels: both sides of axle 3 (the Table 2 axle)
+AXLE3_CHANNELS = ("susp_disp_3L", "susp_disp_3R", "axle_acc_3L", "axle_acc_3R")
+
+
+def fit_channels(available, spec) -> list:
+    """Fitted channels from ``spec`` ('axle3', 'all' or a comma list / sequence)."""
+    resp = [c for c in available if c.split("_")[0] in ("susp", "axle", "body")]
+    if spec is None or spec == "axle3":
+        names = [c for c in AXLE3_CHANNELS if c in resp]
+    elif spec == "all":
+        names = list(resp)
+    else:
+        names = [c.strip() for c in (spec.split(",") if isinstance(spec, str) else spec) if c.strip()]
+        bad = [c for c in names if c not in resp]
+        if bad:
+            raise EroadInputError(f"--channels: {', '.join(bad)} not among the drive's response channels "
+                                  f"({', '.join(resp)})")
+    if not {"susp_disp_3L", "susp_disp_3R"} <= set(names):
+        names = ["susp_disp_3L", "susp_disp_3R"] + [c for c in names if not c.startswith("susp_disp_3")]
+    return names
+
+
+def check_out(out: Path, force: bool) -> None:
+    if out.exists() and not out.is_dir():
+        raise EroadInputError(f"{out}: exists and is not a folder")
+    if out.exists() and any(out.iterdir()) and not force:
+        raise EroadInputError(f"{out}: exists and is not empty; choose another --out or use --force")
+
+
+def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 0, quick: bool = False,
+                  force: bool = False, candidates=None, max_iter=None, effects=None, chassis: str = "rigid",
+                  channels="axle3", argv=None, polish: bool = True, noise_sd=None,
+                  fit_model: str = "simulation", bar=None) -> dict:
+    """Invert a dataset into the run folder ``out`` (see the module docstring).
+
+    Parameters
+    ----------
+    dataset : str or Path
+        Dataset folder.
+    out : str or Path
+        Run folder to create.
+    segments : int, optional
+        K; default chosen by the segmentation.
+    workers : int
+        Processes (1 = serial).
+    seed : int
+        Root seed.
+    quick : bool
+        3 iterations, 6 candidates.
+    force : bool
+        Replace ``out``.
+    candidates, max_iter : int, optional
+        Override the selection size and the iteration cap.
+    effects : dict, optional
+        Effects of the nominal model.
+    chassis : str
+    channels : str or sequence of str
+        Fitted (and simulated) channels: 'axle3' (default), 'all' or names.
+    argv : list of str, optional
+        Command line recorded in run.json.
+    noise_sd : dict, optional
+        Known white sensor noise: channel or quantity (``axle_acc``) -> standard
+        deviation [SI unit of the channel]; the rest is estimated.
+    fit_model : {"simulation", "linear"}
+        The fit's model (:class:`inverse.pipeline.InversionConfig`); recorded in
+        ``summary["fit"]["model"]`` and config.toml.
+    polish : bool
+        The fit's final polishing step over several road realisations
+        (:class:`inverse.sensitivity.FitConfig` ``polish_replicates``); off only to
+        compare.
+    bar : tqdm.tqdm, optional
+        Progress bar (:func:`eroad.progress.progress_bar`), advanced per fit
+        iteration and per candidate realisation.
+
+    Returns
+    -------
+    dict
+        The summary (also ``out/summary.json``).
+    """
+    from drives.format import read_drive
+    from inverse.pipeline import SEED_KEY_FIT, InversionConfig, invert, stream_seed
+    from inverse.realisation import candidate_seeds, select_realisation
+    from inverse.report import (TABLE2_CHANNELS, TABLE2_NOTE, table1, table1_note, table2, write_figures,
+                                write_table)
+    from inverse.uncertainty import overall_fit_quality
+    from inverse.sensitivity import FitConfig
+    from inverse.spectral import ParamBounds
+    from inverse.truck import SIM_DX, TruckPredictRms, make_truck_simulator, nmax_cap
+    from inverse.validation import response_table
+
+    t0 = _time.perf_counter()
+    out = Path(out)
+    record = run_info("invert", run_id=out.name, command=argv or ["run_inversion"], seed=seed)
+    for name, v, lo in (("--workers", workers, 1), ("--seed", seed, 0)):
+        if not isinstance(v, int) or v < lo:
+            raise EroadInputError(f"{name} must be an integer >= {lo}, got {v!r}")
+    if segments is not None and not (isinstance(segments, int) and 1 <= segments <= 12):
+        raise EroadInputError(f"--segments must be an integer in 1..12, got {segments!r}")
+    check_out(out, force)
+    drive = read_drive(dataset)
+    drive.require(["susp_disp_3L", "susp_disp_3R"], "eroad invert")
+    if not np.all(np.asarray(drive.speed) > 0.5):
+        raise EroadInputError(f"{drive.path}: eroad invert needs a moving vehicle (speed > 0.5 m/s throughout)")
+    n_cand = int(candidates if candidates is not None else (6 if quick else 16))
+    iters = int(max_iter if max_iter is not None else (3 if quick else 12))
+    if n_cand < 0 or iters < 1:
+        raise EroadInputError("--candidates must be >= 0 (0: keep the fit's phases) and --max-iter >= 1")
+
+    time = np.asarray(drive.time, float)
+    chans = {c: drive.channels[c].to_numpy(float) for c in fit_channels(drive.channel_names, channels)}
+    speed = np.asarray(drive.speed, float)
+    fit_cfg = FitConfig(max_iter=iters, n_workers=1, **({} if polish else {"polish_replicates": 0}))
+    bounds = ParamBounds(nmax=(1.0, nmax_cap(SIM_DX)))
+    fs = 1.0 / float(np.median(np.diff(time)))
+    noise_psd = noise_psd_from_sd(noise_sd, list(drive.channel_names), fs) if noise_sd else None
+    icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd,
+                           fit_model=fit_model)
+    make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans))
+    predict = TruckPredictRms(drive.vehicle, ("susp_disp_3L", "susp_disp_3R"), chassis=chassis, effects=effects)
+
+    pool = None
+    map_fn = map
+    if workers > 1:
+        from concurrent.futures import ProcessPoolExecutor
+        pool = ProcessPoolExecutor(workers)
+        map_fn = pool.map
+    timing = {}
+    if bar is not None:
+        bar.reset(total=iters + 2)   # the start, the iterations, the polish (an early stop ends short)
+        bar.set_description("invert: fit")
+    try:
+        t1 = _time.perf_counter()
+        inv = invert(time, chans, speed, make_sim, predict_rms=predict, config=icfg, map_fn=map_fn,
+                     progress=None if bar is None else (lambda entry: bar.update(1)))
+        timing["fit_s"] = _time.perf_counter() - t1
+        sim = make_sim(inv.t_bounds)
+        params = inv.fit.params
+        fit_seed = stream_seed(seed, SEED_KEY_FIT)
+        seeds = [fit_seed] + candidate_seeds(seed, n_cand)
+        labels = ["fit"] + [f"c{i}" for i in range(n_cand)]
+        t1 = _time.perf_counter()
+        table_ch = [c for c in TABLE2_CHANNELS if c in chans]
+        sel_map = map_fn
+        if bar is not None:
+            bar.reset(total=len(seeds))
+            bar.set_description("invert: road realisations")
+
+            def sel_map(func, items):   # one step per finished candidate simulation
+                for r in map_fn(func, items):
+                    bar.update(1)
+                    yield r
+        # one seed for both tracks: a per-side choice by the reported RMS would tune Table 2 to itself
+        sel = select_realisation(sim, params, chans, seeds, table_channels=table_ch, map_fn=sel_map,
+                                 labels=labels, sides=False)
+        timing["selection_s"] = _time.perf_counter() - t1
+    finally:
+        if pool is not None:
+            pool.shutdown()
+
+    t1 = _time.perf_counter()
+    if bar is not None:
+        bar.set_description("invert: report")
+    from drives.format import swap_into_place, temp_folder_beside
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = temp_folder_beside(out)
+    (tmp / "tables").mkdir()
+    try:
+        simulated = sel["simulated"]
+        rows = response_table(chans, simulated, table_ch)
+        fit_rows = response_table(chans, sim(params, fit_seed), table_ch) if sel["label"] != "fit" else rows
+        n_extra = (1 if sel["label"] != "fit" else 0) + (1 if sel.get("sides") or "sides_rejected" in sel else 0)
+        segs = inv.segments()
+        summary = {
+            "format": RUN_FORMAT,
+            "dataset": {"name": drive.name, "path": dataset_path(dataset, out), "vehicle": str(drive.vehicle),
+                        "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz,
+                        "warnings": list(drive.warnings)},
+            "segments": segs,
+            "fit_quality": overall_fit_quality(segs),
+            "table2": rows,
+            "errors": headline(rows, sel["spread"]),
+            "selection": {"n_candidates": len(seeds), "selected": sel["label"], "seed": sel["seed"],
+                          "statistic": "sum of w_c ln(rms_sim/rms_meas)^2 over axle_acc_3L/R (w 1) and "
+                                       "susp_disp_3L/R (w 0.25), plus ln(mean_abs ratio)^2 of axle_acc_3L/R",
+                          "per_side": bool(sel.get("sides")), "mismatch": sel["mismatch"],
+                          "sides_rejected": sel.get("sides_rejected"),
+                          "spread": sel["spread"],
+                          "candidates": sel["candidates"],
+                          "fit_phases_errors": headline(fit_rows)},
+            "fit": inv.summary()["fit"],
+            "segmentation": inv.summary()["segmentation"],
+            "road": {"file": "road.npz", "crg": "road.crg", "seed": sel["seed"], "dx": SIM_DX,
+                     "seg_lengths_m": [float(v) for v in sim.layout()["seg_lengths"]]},
+        }
+        write_table(table1(segs), tmp / "tables" / "table1", note=table1_note(summary["fit_quality"]))
+        write_table(table2(rows, sel["spread"]), tmp / "tables" / "table2", note=TABLE2_NOTE)
+        import pandas as pd
+        pd.DataFrame([{"label": c["label"], "seed": c["seed"], "mismatch": c["mismatch"],
+                       **{f"rms_err_{k}": v for k, v in c["rms_err"].items()}} for c in sel["candidates"]]
+                     ).to_csv(tmp / "tables" / "candidates.csv", index=False)
+        seg_sig = chans["susp_disp_3L"]
+        write_figures(tmp / "figures", time=time, measured=chans, simulated=simulated,
+                      segmentation=inv.segmentation, seg_signal=seg_sig, title=f"({drive.name})")
+        road = sim.road(params, sel["seed"])
+        road.save(tmp / "road.npz")
+        road.save(tmp / "road.crg")
+        write_json_atomic(tmp / "history.json", inv.fit.history)
+        timing["report_s"] = _time.perf_counter() - t1
+        timing["total_s"] = _time.perf_counter() - t0
+        timing["n_sims"] = int(inv.fit.n_sims + len(seeds) + n_extra)
+        timing["workers"] = workers
+        summary["timing"] = timing
+        summary["history"] = inv.fit.history
+        write_json_atomic(tmp / "summary.json", summary)
+        import tomli_w
+        cfg = {"dataset": dataset_path(dataset, out), "segments": segments if segments is not None else "auto",
+               "noise_sd": dict(noise_sd or {}), "polish": bool(polish),
+               "workers": workers, "seed": seed, "quick": quick, "candidates": n_cand, "max_iter": iters,
+               "chassis": chassis, "channels": list(chans), "effects": json.dumps(effects or {}),
+               "fit_model": fit_model,
+               "simulator": {"dx_m": SIM_DX, "nmax_cap_cpm": nmax_cap(SIM_DX)},
+               "bounds": {k: list(getattr(bounds, k)) for k in ("Gq_n0", "w", "nmin", "nmax")}}
+        (tmp / "config.toml").write_text(tomli_w.dumps(cfg))
+        write_run_json(tmp, finish_run_info(record, "complete", wall_s=timing["total_s"]))
+        swap_into_place(tmp, out)   # an old RUN (--force) is removed only once the new one is in place
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return summary
+
+
+def dataset_path(dataset, run) -> str:
+    """The dataset folder as recorded in a run: relative to the run folder ``run``
+    (``/``-separated), so the record holds when both move together."""
+    return Path(os.path.relpath(Path(dataset).resolve(), Path(run).resolve())).as_posix()
+
+
+def relocate(run, dataset) -> None:
+    """Re-record the dataset path of an inversion run folder that was moved to ``run``
+    (summary.json's ``dataset.path``, config.toml's ``dataset``, run.json's ``run_id``)."""
+    import tomllib
+
+    import tomli_w
+
+    run = Path(run)
+    rel = dataset_path(dataset, run)
+    sf = run / "summary.json"
+    if sf.is_file():
+        summary = json.loads(sf.read_text())
+        summary.setdefault("dataset", {})["path"] = rel
+        write_json_atomic(sf, summary)
+    rf = run / "run.json"
+    if rf.is_file():
+        write_json_atomic(rf, {**json.loads(rf.read_text()), "run_id": run.name})
+    cf = run / "config.toml"
+    if cf.is_file():
+        cfg = tomllib.loads(cf.read_text())
+        cfg["dataset"] = rel
+        cf.write_text(tomli_w.dumps(cfg))
+
+
+def headline(rows: list, spread: dict | None = None) -> dict:
+    """Per channel relative errors [-] of the RMS and the rectified mean.
+
+    With ``spread`` (over the candidate realisations) ``rms_err`` and ``mean_err`` are the
+    MEDIANS over the realisations, with their 16th/84th percentiles beside them, and the
+    selected realisation's values under ``selected``; without it (the selected
+    realisation's rows only) they are that realisation's, as ``basis`` says.
+    """
+    out = {}
+    for r in rows:
+        if math.isnan(r["rms_err"]):
+            continue
+        sel = {"rms_err": r["rms_err"], "mean_err": r["mean_abs_err"],
+               "rmse_eq6_norm": r["rmse_eq6_norm"], "wasserstein": r["wasserstein"]}
+        sp = (spread or {}).get(r["channel"])
+        if sp and "mean_abs_median" in sp:
+            out[r["channel"]] = {"rms_err": sp["median"], "rms_err_p16": sp["p16"], "rms_err_p84": sp["p84"],
+                                 "mean_err": sp["mean_abs_median"], "mean_err_p16": sp["mean_abs_p16"],
+                                 "mean_err_p84": sp["mean_abs_p84"],
+                                 "rmse_eq6_norm": r["rmse_eq6_norm"], "wasserstein": r["wasserstein"],
+                                 "basis": f"median over {sp['n']} realisations", "selected": sel}
+        else:
+            out[r["channel"]] = {**sel, "basis": "selected realisation"}
+    return out
