@@ -72,10 +72,29 @@ def main(argv=None) -> int:
     ap.add_argument("--rescore", action="store_true",
                     help="re-decide the saved cases of --out with the thresholds given below "
                          "(no simulation) and print the score")
+    ap.add_argument("--sweep", metavar="OTHER", default=None,
+                    help="set the verdict thresholds on the saved cases of --out (best of "
+                         "diagnosis.blind.SWEEP_GRID) and check them on the saved cases of OTHER")
     ap.add_argument("--share-min", type=float, default=None)
     ap.add_argument("--signature-max", type=float, default=None)
     ap.add_argument("--signature-share", type=float, default=None)
     args = ap.parse_args(argv)
+
+    if args.sweep:
+        from diagnosis.blind import rescore, sweep, _family_score
+
+        rows = sweep(args.out)
+        print(f"set on {args.out}: {len(rows)} threshold triples; the ten best")
+        for r in rows[:10]:
+            print(f"  {r['thresholds']}  effect top-1 {r['effect_top1']:.2f}  no-effect right "
+                  f"{r['no_effect_right']:.2f}  confident wrong {r['confident_wrong']}")
+        best = rows[0]["thresholds"]
+        chk = rescore(args.sweep, **best)["results"]
+        fam = _family_score(chk)
+        print(f"checked on {args.sweep} with {best}: effect top-1 {fam['effect_top1']:.2f}, "
+              f"no-effect right {fam['no_effect_right']:.2f}, confident wrong "
+              f"{sum(r['confident_wrong'] for r in chk)} ({fam['n']} cases)")
+        return 0
 
     if args.rescore:
         from diagnosis.blind import format_confusion, rescore

@@ -281,6 +281,47 @@ def rescore(root, **thresholds) -> dict:
     return {"results": results, "score": score(results)}
 
 
+#: threshold grid of :func:`sweep` (the committed values are on it)
+SWEEP_GRID = {"share_min": (0.2, 0.3, 0.4, 0.5, 0.6),
+              "signature_max": (1.5, 2.0, 3.0, 5.0),
+              "signature_share": (0.05, 0.1, 0.15, 0.3)}
+
+
+def sweep(root, grid=None) -> list[dict]:
+    """Re-decide the saved cases of ``root`` at every threshold triple of ``grid``
+    (default :data:`SWEEP_GRID`).
+
+    Returns
+    -------
+    list of dict, best first: ``thresholds``, ``effect_top1``, ``no_effect_right``,
+    ``confident_wrong``, ``balanced`` (mean of the two rates).  Order: no confident
+    wrong answer first, then the balanced rate, then the smaller distance (in grid
+    steps) from the committed thresholds -- the rule by which the thresholds are set
+    on one family before they are checked on the other.
+    """
+    import itertools
+
+    from diagnosis import verdict as V
+
+    grid = dict(SWEEP_GRID, **(grid or {}))
+    committed = {"share_min": V.SHARE_MIN, "signature_max": V.SIGNATURE_CHI2_MAX,
+                 "signature_share": V.SIGNATURE_SHARE_MIN}
+    rows = []
+    for combo in itertools.product(*grid.values()):
+        th = dict(zip(grid, combo))
+        rs = rescore(root, **th)["results"]
+        fam = _family_score(rs)
+        e, n = fam["effect_top1"], fam["no_effect_right"]
+        bal = float(np.nanmean([e, n])) if not (math.isnan(e) and math.isnan(n)) else float("nan")
+        dist = sum(abs(grid[k].index(th[k]) - grid[k].index(committed[k]))
+                   if committed[k] in grid[k] else 0 for k in grid)
+        rows.append(dict(thresholds=th, effect_top1=e, no_effect_right=n,
+                         confident_wrong=int(sum(r["confident_wrong"] for r in rs)),
+                         balanced=bal, distance=dist))
+    rows.sort(key=lambda r: (r["confident_wrong"] > 0, -r["balanced"], r["distance"]))
+    return rows
+
+
 def _rate(flags) -> float:
     return float(np.mean(flags)) if flags else float("nan")
 
