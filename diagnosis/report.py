@@ -208,17 +208,28 @@ def plot_segments(summary: Mapping, path: str | os.PathLike) -> Path:
     wins = dict(zip(summary["localization_settings"]["segments"],
                     summary["localization_settings"]["windows_s"]))
     nch = len(summary["localization_settings"]["channels"])
-    fig = Figure(figsize=(8.0, len(segs) * (0.9 + 0.26 * nch) + 0.6), layout="constrained")
-    axes = fig.subplots(len(segs), 1, squeeze=False)[:, 0]
+    # a grid, two segments a row (one long strip per segment made a 1:4 image)
+    ncol = 1 if len(segs) == 1 else 2
+    nrow = -(-len(segs) // ncol)
+    fig = Figure(figsize=(5.5 * ncol + 1.2, nrow * (0.9 + 0.2 * nch) + 0.6), layout="constrained")
+    grid = fig.subplots(nrow, ncol, squeeze=False)
+    axes = list(grid.ravel())
     vlim = _vlim(summary)
     im = None
-    for ax, seg in zip(axes, segs):
+    for k, (ax, seg) in enumerate(zip(axes, segs)):
         chans, fc, val, sig, est = _matrix(summary, seg)
         im = _heat(ax, chans, fc, val, sig, est, vlim)
+        if k % ncol:
+            ax.set_yticklabels([])
         t0, t1 = wins[seg]
         ax.set_title(f"segment {seg} ({t0:.1f}-{t1:.1f} s): {int(sig.sum())} flagged", fontsize=8)
-    axes[-1].set_xlabel("third-octave band centre [Hz]")
-    fig.colorbar(im, ax=list(axes), label="ln(P_sim / P_meas) [-]", shrink=0.8)
+        if k >= len(segs) - ncol:
+            ax.set_xlabel("third-octave band centre [Hz]", fontsize=8)
+    for ax in axes[len(segs):]:
+        ax.set_visible(False)
+    fig.suptitle("ln(P_sim / P_meas) per segment (o: flagged, FDR q = "
+                 f"{summary['localization_settings']['q']:g}; grey: not estimable)", fontsize=9)
+    fig.colorbar(im, ax=axes[:len(segs)], label="ln(P_sim / P_meas) [-]", shrink=0.8)
     fig.savefig(path, dpi=130)
     return Path(path)
 
@@ -227,8 +238,14 @@ def plot_transmissibility(summary: Mapping, path: str | os.PathLike) -> Path:
     """Axle-to-body transmissibility log ratio per band with its interval, per pair (PNG)."""
     T = summary["transmissibility"]
     pairs = T["pairs"]
-    fig = Figure(figsize=(8.0, 1.0 + 1.6 * len(pairs)), layout="constrained")
-    axes = fig.subplots(len(pairs), 1, squeeze=False, sharex=True)[:, 0]
+    ncol = 2 if len(pairs) > 2 else 1      # left and right side by side
+    nrow = -(-len(pairs) // ncol)
+    fig = Figure(figsize=(5.5 * ncol, 1.2 + 1.7 * nrow), layout="constrained")
+    axes = list(fig.subplots(nrow, ncol, squeeze=False, sharex=True).ravel())
+    for ax in axes[len(pairs):]:
+        ax.set_visible(False)
+    lvl = (f"{T['ci_level']:.3g} interval (FCR-adjusted: 1 - q x flagged/tested, "
+           f"q = {T['q']:g})")
     for ax, (a, b) in zip(axes, pairs):
         rows = [r for r in T["cells"] if r["input"] == a and r["output"] == b]
         fc = np.array([r["band_centre_hz"] for r in rows])
@@ -237,14 +254,17 @@ def plot_transmissibility(summary: Mapping, path: str | os.PathLike) -> Path:
         hi = np.array([np.nan if r["ci_hi"] is None else r["ci_hi"] for r in rows])
         sig = np.array([r["significant"] for r in rows])
         ax.axhline(0, color="0.5", lw=0.8)
-        ax.fill_between(fc, lo, hi, color="C0", alpha=0.25, step="mid", label=f"{T['ci_level']:.3g} interval")
+        ax.fill_between(fc, lo, hi, color="C0", alpha=0.25, step="mid", label=lvl)
         ax.plot(fc, d, "o-", color="C0", ms=3, lw=1, label="ln|H_sim| - ln|H_meas|")
         ax.plot(fc[sig], d[sig], "o", color="C3", ms=6, mfc="none", label="flagged")
         ax.set_xscale("log")
         ax.set_ylabel("log ratio [-]", fontsize=8)
         ax.set_title(f"transmissibility {a} -> {b}", fontsize=8)
-    axes[0].legend(fontsize=7, loc="best")
-    axes[-1].set_xlabel("third-octave band centre [Hz]")
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=3, fontsize=7)
+    for ax in axes[max(0, len(pairs) - ncol):len(pairs)]:
+        ax.set_xlabel("third-octave band centre [Hz]", fontsize=8)
+    fig.suptitle("axle-to-body transmissibility, ln|H_sim| - ln|H_meas| per band (independent "
+                 "of the road: a gap here is the vehicle's)", fontsize=9)
     fig.savefig(path, dpi=130)
     return Path(path)
 
@@ -264,14 +284,18 @@ def plot_ranking(summary: Mapping, path: str | os.PathLike) -> Path:
     ax = fig.add_subplot()
     y = np.arange(len(names))
     colors = ["0.4"] + [("C2" if r["accepted"] else "C0") for r in R]
-    ax.barh(y, vals, color=colors)
+    ax.barh(y, vals, color=colors, zorder=2)
     for i, r in enumerate(R, start=1):
         s = r["heldout_gap_after_per_seed"]
-        ax.plot([min(s), max(s)], [i, i], color="k", lw=1)
+        ax.plot([min(s), max(s)], [i, i], color="k", lw=1, zorder=3)
     b = np.array(per_seed[0])
-    ax.plot([b.min(), b.max()], [0, 0], color="k", lw=1)
+    ax.plot([b.min(), b.max()], [0, 0], color="k", lw=1, zorder=3)
     m, sd = nom["null_gap_mean"], nom["null_gap_std"] or 0.0
-    ax.axvspan(m - 2 * sd, m + 2 * sd, color="0.8", alpha=0.6, label="nominal vs nominal (mean +- 2 sd)")
+    # the noise band behind the bars, its edges dashed on top so it stays readable
+    ax.axvspan(m - 2 * sd, m + 2 * sd, color="0.85", zorder=0,
+               label="nominal vs nominal (mean +- 2 sd): the noise level")
+    for v in (m - 2 * sd, m + 2 * sd):
+        ax.axvline(v, color="0.35", lw=0.8, ls="--", zorder=4)
     ax.set_yticks(y)
     ax.set_yticklabels(names, fontsize=8)
     ax.invert_yaxis()
@@ -289,6 +313,9 @@ def plot_shrink_bands(summary: Mapping, path: str | os.PathLike) -> Path:
     fc = np.array([r["band_centre_hz"] for r in H["per_band"]])
     b = np.array([np.nan if r["gap_before"] is None else r["gap_before"] for r in H["per_band"]])
     a = np.array([np.nan if r["gap_after"] is None else r["gap_after"] for r in H["per_band"]])
+    # only bands where both gaps exist are compared (a band with one of them alone is no shrink)
+    both = np.isfinite(a) & np.isfinite(b)
+    a, b = np.where(both, a, np.nan), np.where(both, b, np.nan)
     fig = Figure(figsize=(8.0, 3.2), layout="constrained")
     ax = fig.add_subplot()
     ax.plot(fc, b, "o-", color="0.3", ms=3, label="nominal model")

@@ -178,7 +178,9 @@ def write_figures(fig_dir: Path, *, time, measured: dict, simulated: dict, segme
         out.append(plot_segmentation(segmentation, time, seg_signal, fig_dir / f"figure6_segmentation.{ext}",
                                      title=f"Figure 6: segmentation {title}"))
         out.append(plot_time_compare(time, measured, simulated, chans, fig_dir / f"figure8_time_compare.{ext}",
-                                     title=f"Figure 8: measured vs simulated, axle 3 {title}"))
+                                     title=f"Figure 8: measured vs simulated, axle 3 {title}\n"
+                                           "simulated on a random-phase road of the fitted spectra: "
+                                           "not a phase-true (waveform) comparison"))
         out.append(plot_amplitude_distributions(measured, simulated, chans,
                                                 fig_dir / f"figure9_amplitude_distributions.{ext}",
                                                 title=f"Figure 9: amplitude distributions {title}"))

@@ -460,9 +460,9 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
         sel = (result.time >= a) & (result.time < b)
         level = np.sqrt(np.mean(result.lrms[sel] ** 2)) if np.any(sel) else np.nan
         a2.hlines(1e3 * level, a, b, color="C3", lw=2, label="segment RMS" if i == 0 else None)
-        label = f"S{i + 1}" + (f": {result.classes[i]}" if result.classes[i] else "")
-        a1.text(0.5 * (a + b), 1.0, label, transform=a1.get_xaxis_transform(), ha="center",
-                va="bottom", fontsize=9)
+        # numbered as Table 1's 'segment' column (the fitted class is Table 1's)
+        a1.text(0.5 * (a + b), 1.0, f"{i + 1}", transform=a1.get_xaxis_transform(), ha="center",
+                va="bottom", fontsize=9, fontweight="bold")
     for ax in (a1, a2):
         for j, tb in enumerate(result.t_bounds[1:-1]):
             ax.axvline(tb, color="C3", lw=1, label="boundary found (speed-corrected power)" if (ax is a2 and j == 0) else None)
@@ -474,9 +474,9 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
     a2.legend(loc="lower right", fontsize=8)
     if title:
         fig.suptitle(title)
-    if any(result.classes):
-        fig.text(0.01, 0.005, "Sk: X = segment k and its initial class from the RMS level; the "
-                 "fitted classes are in Table 1", fontsize=7, color="0.3")
+    fig.text(0.01, 0.005, "Numbers above the record: segments as numbered in Table 1 (its "
+             "'segment' column), where each segment's fitted class and parameters are.",
+             fontsize=7, color="0.3")
     fig.tight_layout(rect=(0, 0.02, 1, 1))
     path = Path(path)
     fig.savefig(path, dpi=150)

@@ -581,6 +581,27 @@ def trend_summary(energies, threshold: float = 1.25) -> dict:
 _BAND_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
 
 
+def square_unit(unit: str) -> str:
+    """A squared unit for a label: ``(m)^2`` -> ``m²``, ``(m/s^2)^2`` -> ``(m/s²)²``."""
+    u = str(unit)
+    if u.startswith("(") and u.endswith(")^2"):
+        inner = u[1:-3]
+        u = f"{inner}^2" if all(c.isalnum() for c in inner) else f"({inner})^2"
+    return u.replace("^2", "\u00b2")
+
+
+def readable_log_axis(ax, max_decades: float = 1.5) -> None:
+    """A log y axis spanning less than ``max_decades`` gets ticks at 1, 2, 5 x 10^k with
+    plain labels (matplotlib's default leaves one labelled tick, or none, on such a range)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    lo, hi = ax.get_ylim()
+    if lo > 0 and np.log10(hi / lo) < max_decades:
+        ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(NullFormatter())
+
+
 def plot_chassis_study(data_dir: str | Path, figures_dir: str | Path, pdf: bool = True
                        ) -> list[Path]:
     """Figures of a chassis-stiffness run, drawn from its ``data/`` files.
@@ -661,19 +682,25 @@ def plot_chassis_study(data_dir: str | Path, figures_dir: str | Path, pdf: bool 
                 ax.plot(fx, mean, "o-", color=col, ms=4, label=f"{lab} Hz")
                 if ys.shape[0] > 1:
                     ax.fill_between(fx, lo, hi, color=col, alpha=0.15, lw=0)
-                if has_rigid:
+                if has_rigid and kind == "energy":
                     r = sub["rigid"].to_numpy(float)
-                    ax.plot([x_rigid], [r.mean()], "*", color=col, ms=11, mec="k", mew=0.5)
+                    # the bands' stars side by side (on top of each other they hid one another)
+                    xr = x_rigid * 1.15 ** (b - (len(labels) - 1) / 2)
+                    ax.plot([xr], [r.mean()], "*", color=col, ms=10, mec="k", mew=0.5, zorder=3)
                     ax.axhline(r.mean(), color=col, ls=":", lw=0.9)
                     if r.size > 1:
-                        ax.errorbar([x_rigid], [r.mean()], yerr=[[r.mean() - r.min()],
-                                                                 [r.max() - r.mean()]],
+                        ax.errorbar([xr], [r.mean()], yerr=[[r.mean() - r.min()],
+                                                            [r.max() - r.mean()]],
                                     color=col, lw=0.8, capsize=2)
+            if has_rigid and kind == "ratio":   # 1 for every band by definition: one star
+                ax.plot([x_rigid], [1.0], "*", color="k", ms=11, zorder=3)
+                ax.axhline(1.0, color="k", ls=":", lw=0.9)
             ax.set_yscale("log")
+            readable_log_axis(ax)
             frame_axis(ax)
             _, _, u, lab_q = QUANTITIES[q]
             ax.set_title(f"{q}: {lab_q}", fontsize=9)
-            ax.set_ylabel(f"band mean square [{unit}]" if kind == "energy"
+            ax.set_ylabel(f"band mean square [{square_unit(unit)}]" if kind == "energy"
                           else "E / E(rigid frame) [-]", fontsize=8)
             ax.grid(True, which="major", alpha=0.3)
             ax.tick_params(labelsize=8)
@@ -682,9 +709,11 @@ def plot_chassis_study(data_dir: str | Path, figures_dir: str | Path, pdf: bool 
                    title="frequency band", title_fontsize=9, frameon=False)
         n_roads = df["road_index"].nunique()
         what = "band energy" if kind == "energy" else "band energy relative to the rigid frame"
+        rig = ("stars + dotted lines: rigid frame" if kind == "energy" else
+               "star + dotted line: rigid frame = 1 for every band")
         fig.suptitle(f"Chassis-stiffness study: pantograph-base {what} vs frame stiffness "
                      f"(DCDC mounts x{m_nom:g}; mean over {n_roads} road(s), range shaded; "
-                     f"star + dotted line: rigid frame)", fontsize=10)
+                     f"{rig})", fontsize=10)
         fig.tight_layout(rect=(0, 0.07, 1, 0.96))
         save(fig, f"band_{kind}_vs_frame.png")
 
@@ -710,7 +739,8 @@ def plot_chassis_study(data_dir: str | Path, figures_dir: str | Path, pdf: bool 
             ax.set_xlabel("DCDC mount stiffness factor [-]")
             _, _, u, lab_q = QUANTITIES[q]
             ax.set_title(f"{q}: {lab_q}", fontsize=9)
-            ax.set_ylabel(f"band mean square [{unit}]", fontsize=8)
+            ax.set_ylabel(f"band mean square [{square_unit(unit)}]", fontsize=8)
+            readable_log_axis(ax)
             ax.grid(True, which="major", alpha=0.3)
             ax.tick_params(labelsize=8)
         handles, labs = axes[0, 0].get_legend_handles_labels()

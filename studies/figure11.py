@@ -1159,9 +1159,14 @@ def evaluate_findings(motion: Mapping[str, np.ndarray], fs: float, modes: list[d
         "lateral base motion comes from roll of the tall block about the low roll axis and "
         "from the DCDC lateral/roll mount modes"))
     for fd_ in out:
-        fd_.criterion = fd_.criterion.replace("F_MAX", f"{f_max:g} Hz").replace(
-            "PEAK_PROMINENCE", f"{prominence:g}")
+        fd_.criterion = filled_criterion(fd_.criterion, f_max, prominence)
     return out
+
+
+def filled_criterion(text: str, f_max: float = F_MAX, prominence: float = PEAK_PROMINENCE) -> str:
+    """A :data:`CRITERIA` text with its placeholders (F_MAX, PEAK_PROMINENCE) replaced by
+    the values used."""
+    return text.replace("F_MAX", f"{f_max:g} Hz").replace("PEAK_PROMINENCE", f"{prominence:g}")
 
 
 def findings_markdown(findings: list[Finding], meta: dict | None = None) -> str:
@@ -1239,8 +1244,10 @@ def write_findings(findings: list[Finding], folder: str | Path, meta: dict | Non
     from studies.runs import write_json_atomic
 
     folder = Path(folder)
+    used = {f.id: f.criterion for f in findings}   # filled with the values they were judged by
     pj = write_json_atomic(folder / "findings.json",
-                           {"criteria": {k: v[1] for k, v in CRITERIA.items()},
+                           {"criteria": {k: used.get(k, filled_criterion(v[1]))
+                                         for k, v in CRITERIA.items()},
                             "smooth_hz": SMOOTH_HZ, "findings": [f.to_dict() for f in findings]})
     pm = folder / "findings.md"
     tmp = folder / f".findings.md.tmp"

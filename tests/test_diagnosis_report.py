@@ -73,3 +73,60 @@ def test_figures_replot_from_saved_summary(tmp_path, results):
     assert s["verdict"] == "none" and s["ranking"] == []
     assert np.isfinite([r["log_psd_ratio"] for r in s["localization"]
                         if r["log_psd_ratio"] is not None]).all()
+
+
+def _captured_figures(monkeypatch):
+    """Keep every Figure that diagnosis.report saves (to look at what was drawn)."""
+    from matplotlib.figure import Figure
+
+    saved = []
+    real = Figure.savefig
+
+    def keep(self, *a, **k):
+        saved.append(self)
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(Figure, "savefig", keep)
+    return saved
+
+
+def test_report_figures_read_right(tmp_path, results, monkeypatch):
+    """segments.png is a grid, not a tall strip; the transmissibility interval says what
+    its level is; the ranking's noise band lies behind the bars; the per-band shrink
+    shows only bands where both gaps exist (no lone point)."""
+    from PIL import Image
+
+    from diagnosis.report import (plot_ranking, plot_segments, plot_shrink_bands,
+                                  plot_transmissibility)
+
+    out = write_report(tmp_path / "run", meta={"dataset": "toy"}, **results)
+    s = json.loads((out / "summary.json").read_text())
+    # four segments (the embedded drive's count): S1, S2 and copies of them as S3, S4
+    s4 = json.loads(json.dumps(s))
+    st = s4["localization_settings"]
+    extra = {"S1": "S3", "S2": "S4"}
+    s4["localization"] += [dict(r, segment=extra[r["segment"]]) for r in s4["localization"]
+                           if r["segment"] in extra]
+    st["windows_s"] = st["windows_s"] + [st["windows_s"][st["segments"].index(k)] for k in extra]
+    st["segments"] = st["segments"] + list(extra.values())
+    plot_segments(s4, tmp_path / "seg.png")
+    with Image.open(tmp_path / "seg.png") as im:
+        w, h = im.size
+    assert h <= 1.2 * w, (w, h)
+    saved = _captured_figures(monkeypatch)
+    plot_transmissibility(s, tmp_path / "t.png")
+    labels = [t.get_text() for lg in saved[-1].legends for t in lg.get_texts()]
+    assert any("FCR-adjusted" in t and "q = " in t for t in labels), labels
+    plot_ranking(s, tmp_path / "r.png")
+    ax = saved[-1].axes[0]
+    band = [p for p in ax.patches if p.get_label().startswith("nominal vs nominal")]
+    bars = [p for p in ax.patches if p not in band]
+    assert bars and band and max(p.get_zorder() for p in band) < min(p.get_zorder() for p in bars)
+    # a band where the nominal gap is missing but the effect's is not
+    s2 = json.loads(json.dumps(s))
+    pb = s2["how_far"]["per_band"]
+    pb[0]["gap_before"], pb[0]["gap_after"] = None, 1.0
+    plot_shrink_bands(s2, tmp_path / "s.png")
+    for line in saved[-1].axes[0].get_lines()[:2]:
+        y = np.asarray(line.get_ydata(), float)
+        assert np.isnan(y[0]), line.get_label()

@@ -177,3 +177,45 @@ def test_code_version_covers_vehicle_model(tmp_path):
     assert _code_version_of(root) == v                # restored: same token again
     (root / "docs" / "vehicles.md").write_text("edited")
     assert _code_version_of(root) == v                # documentation is not run by a case
+
+
+def test_figures_units_ticks_and_rigid_markers(quick_runs, tmp_path, monkeypatch):
+    """Replotted from the quick run's data: squared units read m², rad², (m/s²)² (not
+    "(m)^2"); every log panel spanning less than 1.5 decades carries at least two labelled
+    ticks; the ratio figure marks the rigid frame (1 for every band) with one star per
+    panel, the energy figure with one star per band, side by side."""
+    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
+
+    from studies.chassis_study import plot_chassis_study, square_unit
+
+    assert [square_unit(u) for u in ("(m)^2", "(rad)^2", "(m/s^2)^2", "(rad/s^2)^2")] == \
+        ["m\u00b2", "rad\u00b2", "(m/s\u00b2)\u00b2", "(rad/s\u00b2)\u00b2"]
+    first, _, root = quick_runs
+    folder = root / STUDY / first["path"].rsplit("/", 1)[-1]
+    saved = {}
+    real = Figure.savefig
+
+    def keep(self, path, *a, **k):
+        saved[str(path).rsplit("/", 1)[-1]] = self
+        return real(self, path, *a, **k)
+
+    monkeypatch.setattr(Figure, "savefig", keep)
+    plot_chassis_study(folder / "data", tmp_path, pdf=False)
+    for name in ("band_energy_vs_frame.png", "band_ratio_vs_frame.png"):
+        fig = saved[name]
+        fig.canvas.draw()
+        for ax in fig.axes[:8]:
+            assert "(m)^2" not in ax.get_ylabel() and "^2" not in ax.get_ylabel(), ax.get_ylabel()
+            lo, hi = ax.get_ylim()
+            if np.log10(hi / lo) < 1.5:
+                shown = [t for t in ax.yaxis.get_majorticklabels()
+                         if t.get_text() and lo <= t.get_position()[1] <= hi]
+                assert len(shown) >= 2, (name, ax.get_title(), lo, hi)
+            stars = [ln for ln in ax.get_lines() if ln.get_marker() == "*"]
+            if name == "band_ratio_vs_frame.png":
+                assert len(stars) == 1 and stars[0].get_ydata()[0] == 1.0
+            else:
+                xs = [ln.get_xdata()[0] for ln in stars]
+                assert len(stars) == 4 and len(set(xs)) == 4
+    plt.close("all")

@@ -127,6 +127,11 @@ def test_findings_files(tmp_path):
     assert [f["id"] for f in doc["findings"]] == list("abcde")
     assert all(f["criterion"] and f["values"] for f in doc["findings"])
     assert "| (c) |" in pm.read_text()
+    # no placeholder is left for a reader to resolve, in the criteria table or the findings
+    text = pj.read_text() + pm.read_text()
+    assert "F_MAX" not in text and "PEAK_PROMINENCE" not in text
+    assert doc["criteria"]["e"].startswith("E_Ty_acc(20 Hz-40 Hz)")
+    assert doc["criteria"] == {f["id"]: f["criterion"] for f in doc["findings"]}
 
 
 def test_eroad_study_pantograph_archives_a_run(short_road, tmp_path, capsys):
