@@ -78,6 +78,8 @@ TABLE2_NOTE = (
     "(the paper's 'mean acceleration': a gravity-free acceleration has zero mean). The "
     "'selected_' columns belong to the one realisation kept for the road files and Figures 8-9, "
     "chosen by its RMS nearness to the measurement: they are not an independent check. "
+    "Units: 'unit' is that of the rms_meas, rms_sim_median, rect_mean_meas and selected_rms_sim "
+    "columns; *_pct columns are per cent; the rest are dimensionless. "
     "Errors are (simulated - measured) / measured in %; rmse_eq6_norm is eq 6's RMSE over the "
     "measured RMS (about 1.4 for two signals of unrelated phase); W1_over_sd is the "
     "Wasserstein-1 distance of the amplitude distributions over the measured sd.")

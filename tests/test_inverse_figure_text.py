@@ -62,3 +62,17 @@ def test_figure9_defines_w1_over_sd(figures):
     saved, _ = figures
     texts = " ".join(_texts(saved["figure9_amplitude_distributions.png"]))
     assert "W1/sd" in texts and "Wasserstein-1" in texts and "standard deviation" in texts
+
+
+def test_table2_says_its_units_and_what_its_means_are():
+    """Table 2 carries a unit column, names its means rectified (rect_mean), and its note
+    says which columns the unit belongs to."""
+    from inverse.report import TABLE2_NOTE, table2
+
+    row = {"channel": "susp_disp_3L", "rms_meas": 0.008, "mean_abs_meas": 0.0045, "rms_sim": 0.0077,
+           "rms_err": -0.04, "mean_abs_err": -0.03, "rmse_eq6_norm": 1.4, "wasserstein": 0.04,
+           "ks": 0.03}
+    df = table2([row])
+    assert df["unit"].tolist() == ["m"]
+    assert "rect_mean_meas" in df.columns and not any(c.startswith("mean") for c in df.columns)
+    assert "'unit' is that of the rms_meas" in TABLE2_NOTE and "rectified mean" in TABLE2_NOTE
