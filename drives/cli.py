@@ -59,7 +59,7 @@ def register(subparsers) -> None:
         description="Make a measurement dataset from a known truth (road segments, speed "
         "profile, truth vehicle with effects, sensor noise); everything used goes to "
         "OUT/truth/. Scenarios: luliang (the paper's 460-490 s window, the embedded "
-        "default), random (seed draws the road and speed), null (truth vehicle = nominal "
+        "default; its whole 400-580 s record goes to OUT/record/), random (seed draws the road and speed), null (truth vehicle = nominal "
         "model), or a TOML file with --config. Same seed, same bytes.",
         epilog="Example: eroad synth --scenario luliang --seed 0 --out luliang-0")
     syn.add_argument("--scenario", default=None,
@@ -73,7 +73,9 @@ def register(subparsers) -> None:
                      help="drop the scenario's own effects (keep only --effect ones)")
     syn.add_argument("--vehicle", default=None,
                      help="built-in vehicle id or vehicle TOML file (default per scenario)")
-    syn.add_argument("--duration", type=float, default=None, help="record length [s]")
+    syn.add_argument("--duration", type=float, default=None,
+                     help="record length [s]; for a scenario with a window (luliang) the "
+                     "window's length, cut from the same record")
     syn.add_argument("--config", default=None, metavar="TOML",
                      help="scenario TOML setting everything explicitly (see "
                      "drives/scenarios/luliang.toml)")
