@@ -783,7 +783,10 @@ def list_runs(root: str | os.PathLike = "results", study: str | None = None) -> 
         if study is not None and group != study:
             continue
         try:
-            records.append(load_run(run_dir))
+            rec = load_run(run_dir)
+            if group == run_dir.name and not (run_dir / RUN_FILE).is_file():   # a study of one run
+                rec = RunRecord(path=rec.path, info={**rec.info, "study": group}, summary=rec.summary)
+            records.append(rec)
         except EroadInputError as exc:
             records.append(RunRecord(path=run_dir, info=normalize_info(
                 {"status": "unreadable", "error": {"type": "", "message": str(exc)}}, run_dir)))

@@ -40,12 +40,12 @@ from eroad.errors import EroadInputError
 MANIFEST = [
     ("Figure 4", "fig4_5", "figure4_displacement.png", "drives.figures.plot_figures"),
     ("Figure 5", "fig4_5", "figure5_spectrum.png", "drives.figures.plot_figures"),
-    ("Figure 6", "invert", "figures/figure6_segmentation.png", "inverse.cli.run_inversion"),
-    ("Table 1", "invert", "tables/table1.md", "inverse.cli.run_inversion"),
-    ("Figure 8", "invert", "figures/figure8_time_compare.png", "inverse.cli.run_inversion"),
-    ("Figure 9", "invert", "figures/figure9_amplitude_distributions.png", "inverse.cli.run_inversion"),
-    ("Table 2", "invert", "tables/table2.md", "inverse.cli.run_inversion"),
-    ("Global road (section 2.5)", "invert", "road.npz", "inverse.cli.run_inversion"),
+    ("Figure 6", "invert", "figures/figure6_segmentation.png", "inverse.run.run_inversion"),
+    ("Table 1", "invert", "tables/table1.md", "inverse.run.run_inversion"),
+    ("Figure 8", "invert", "figures/figure8_time_compare.png", "inverse.run.run_inversion"),
+    ("Figure 9", "invert", "figures/figure9_amplitude_distributions.png", "inverse.run.run_inversion"),
+    ("Table 2", "invert", "tables/table2.md", "inverse.run.run_inversion"),
+    ("Global road (section 2.5)", "invert", "road.*", "inverse.run.run_inversion"),
     ("Table 1, nominal vs corrected model", "invert", "tables/table1_nominal_vs_corrected.md",
      "diagnosis.closed_loop.invert_closed_loop"),
     ("Figure 11", "figure11", "figures/figure11.png", "studies.figure11.run_figure11"),
@@ -181,12 +181,10 @@ def _jsonable(obj):
 
 
 def _manifest(run: Path) -> list:
-    rows = []
-    for item, step, pattern, code in MANIFEST:
-        files = sorted(str(p.relative_to(run)) for p in (run / step).glob(pattern)) \
-            if (run / step).is_dir() else []
-        rows.append({"item": item, "files": files, "code": code, "present": bool(files)})
-    return rows
+    """Manifest rows: each paper item with the files of it the run holds (relative to the run)."""
+    from eroad.archive import manifest_rows
+
+    return manifest_rows(run, [(item, f"{step}/{pattern}", code) for item, step, pattern, code in MANIFEST])
 
 
 def _manifest_md(rows: list, timings: dict, fit_quality: dict | None = None) -> str:
@@ -230,7 +228,7 @@ def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False
     dict
         The summary (also ``summary.json``): per-step summaries, timings, manifest.
     """
-    from studies.runs import git_state, package_versions, write_json_atomic
+    from eroad.archive import finish_run_info, run_info, write_json_atomic, write_run_json
 
     out = Path(out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
@@ -246,16 +244,8 @@ def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False
     tmp.mkdir()
     wanted = [name for name, _ in STEPS] if steps is None else list(steps)
     start = time.time()
-    import platform
-    import socket
-
-    stamp = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
-    # the archive's run.json fields (studies.runs) beside this command's own
-    record = {"command": sys.argv, "quick": quick, "workers": workers, "git": git_state(),
-              "versions": package_versions(), "start": stamp, "start_utc": stamp, "end_utc": None,
-              "seed": 0, "host": {"hostname": socket.gethostname(), "platform": platform.platform(),
-                                  "machine": platform.machine(), "cpu_count": os.cpu_count()},
-              "status": "running"}
+    record = run_info("reproduce", run_id=out.name, seed=0,   # every step runs with seed 0
+                      extra={"quick": quick, "workers": workers})
     timings, results = {}, {}
     try:
         for name, func in STEPS:
@@ -266,17 +256,14 @@ def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False
             results[name] = func(tmp, quick, workers, log)
             timings[name] = time.perf_counter() - t0
             log(f"[{name}] done in {timings[name]:.1f} s")
-        record["status"] = "complete"
+        finish_run_info(record, "complete", wall_s=time.time() - start)
     except BaseException as exc:
-        record["status"] = "failed"
-        record["error"] = f"{type(exc).__name__}: {exc}"
+        finish_run_info(record, "failed", wall_s=time.time() - start, error=exc)
         raise
     finally:
-        record["wall_s"] = time.time() - start
-        record["end_utc"] = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
-        record["timings_s"] = timings
+        record["extra"]["timings_s"] = timings
         rows = _manifest(tmp)
-        write_json_atomic(tmp / "run.json", record)
+        write_run_json(tmp, record)
         summary = {"status": record["status"], "quick": quick, "timings_s": timings,
                    "wall_s": record["wall_s"], "manifest": rows, "steps": results}
         write_json_atomic(tmp / "summary.json", _jsonable(summary))
@@ -292,28 +279,37 @@ def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False
 
 
 def _repoint(folder: Path, old: Path, new: Path, max_bytes: int = 20_000_000) -> int:
-    """Replace the temporary run path by the final one in the run's text records.
+    """Replace the temporary run path in the run's text records by a relative path.
 
     Steps record the paths they were given (the dataset, their output); those pointed
     into the temporary folder, which no longer exists once it is renamed into place.
+    Each becomes relative to the run folder the file belongs to (the nearest folder
+    above it holding a ``run.json``), so the records stay right when the run is moved
+    or committed.
 
     Returns
     -------
     int
         Number of files rewritten.
     """
-    old_s, new_s = str(old.resolve()), str(new.resolve())
+    old_s = str(old.resolve())
+    new = new.resolve()
     n = 0
     for path in folder.rglob("*"):
         if path.suffix not in (".json", ".md", ".toml", ".txt") or not path.is_file() \
                 or path.stat().st_size > max_bytes:
             continue
         text = path.read_text(encoding="utf-8")
-        if old_s in text:
-            tmp_file = path.with_name(path.name + ".repoint")
-            tmp_file.write_text(text.replace(old_s, new_s), encoding="utf-8")
-            tmp_file.replace(path)
-            n += 1
+        if old_s not in text:
+            continue
+        run_dir = path.parent
+        while run_dir != folder and not (run_dir / "run.json").is_file():
+            run_dir = run_dir.parent
+        rel = Path(os.path.relpath(new, run_dir.resolve())).as_posix()
+        tmp_file = path.with_name(path.name + ".repoint")
+        tmp_file.write_text(text.replace(old_s + "/", rel + "/").replace(old_s, rel), encoding="utf-8")
+        tmp_file.replace(path)
+        n += 1
     return n
 
 

@@ -8,6 +8,7 @@ two steps (about 5 s): the same on-disk validation for Figures 4-5, and that the
 manifest reports every item of the steps not run as missing.
 """
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -142,11 +143,17 @@ def test_partial_reproduce_files_and_manifest(partial_run):
 
 def test_recorded_paths_point_into_the_final_folder(partial_run):
     """Steps record the dataset path they were given; after the temporary run folder is
-    renamed into place, those records must name the final folder, not the vanished one."""
+    renamed into place, those records name the dataset relative to the run (so they hold
+    when the run is moved or committed), never the vanished temporary folder."""
     out = partial_run
-    texts = [p.read_text() for p in out.rglob("*.json")]
-    assert not any(".run.tmp-" in t for t in texts)
-    assert any(str(out.resolve()) in t for t in texts)
+    texts = {p: p.read_text() for p in out.rglob("*.json") if p.name != "run.json"}
+    assert not any(".run.tmp-" in t for t in texts.values())
+    assert not any(str(out.resolve()) in t for t in texts.values())
+    rel = [(p, m) for p, t in texts.items() for m in re.findall(r'"(\.{1,2}/dataset)"', t)]
+    assert rel, "no record of the dataset path"
+    for p, m in rel:    # relative to the run folder (the nearest folder up holding run.json)
+        run = next(d for d in p.parents if (d / "run.json").is_file())
+        assert (run / m / "channels.csv").is_file(), (p, m)
 
 
 @pytest.mark.slow
