@@ -98,6 +98,20 @@ QUANTITIES: dict[str, Quantity] = {
                       "vehicle speed"),
 }
 
+#: displacements [m] above their limit but below these are not millimetres (a record in
+#: millimetres peaks at several units) but a physically impossible travel: a diverged
+#: simulation or a faulty sensor
+NOT_A_UNIT_BELOW = {"susp_disp": 2.0, "dcdc_y": 3.0, "dcdc_z": 3.0}
+
+
+def implausible_hint(quantity: str, peak: float) -> str:
+    """What a value ``peak`` above its quantity's limit most likely means."""
+    q = QUANTITIES[quantity]
+    if peak < NOT_A_UNIT_BELOW.get(quantity, 0.0):
+        return (f"physically impossible for a truck ({q.doc}): a diverged simulation or a "
+                "faulty sensor, not a unit")
+    return q.wrong_unit_hint
+
 _WHEEL_RE = re.compile(r"^(susp_disp|axle_acc|body_acc)_([1-9][0-9]*)([LR])$")
 _DCDC_RE = re.compile(r"^(dcdc_[yz])_P([1-4])$")
 
@@ -524,7 +538,8 @@ def _read_values(csv: Path, cols: list[str], probs: _Problems):
         q = QUANTITIES[parse_channel(c)[0]]
         if c in peak and peak[c][0] > q.limit:
             probs.add(csv, f"|value| up to {peak[c][0]:.4g} is implausible in {q.unit} "
-                      f"(limit {q.limit:g} {q.unit}): {q.wrong_unit_hint}", column=c,
+                      f"(limit {q.limit:g} {q.unit}): "
+                      f"{implausible_hint(parse_channel(c)[0], peak[c][0])}", column=c,
                       row=peak[c][1])
             ok = False
     if neg_speed is not None:

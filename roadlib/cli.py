@@ -290,10 +290,41 @@ def cmd_psd(args) -> int:
             band = (max(band[0], float(pm["nmin"])), min(band[1], 0.97 * float(pm["nmax"])))
     fit = fit_iso_psd(est, band=band, w=2.0 if args.fixed_w else None)
     summary = {"file": str(p), "tracks": what, "dx": dx, "n_averages": est.n_averages, **fit.to_dict()}
-    _print(args, summary, f"{p}: Gd(n0) = {fit.Gd_n0:.4e} m^3 (+-{100 * fit.Gd_n0_rel_se:.1f} %), "
-           f"w = {fit.w:.3f} (+-{fit.w_se:.3f}), class {fit.iso_class}, band {band[0]:.3g}-{band[1]:.3g} "
-           f"cycles/m, {what}")
+    text = (f"{p}: Gd(n0) = {fit.Gd_n0:.4e} m^3 (+-{100 * fit.Gd_n0_rel_se:.1f} %), "
+            f"w = {fit.w:.3f} (+-{fit.w_se:.3f}), class {fit.iso_class}, band {band[0]:.3g}-{band[1]:.3g} "
+            f"cycles/m, {what}")
+    if np.ndim(z) == 2 and np.shape(z)[1] > 1:
+        # neighbouring tracks are nearly one profile at long wavelengths: the +- intervals
+        # count them as the independent tracks they are worth (roadlib.tracks)
+        from roadlib.tracks import effective_tracks, fit_weights
+
+        m = np.shape(z)[1]
+        free_w = not args.fixed_w
+        n_gd = effective_tracks(z, dx, est.nperseg, band, weights=lambda n: fit_weights(n, free_w=free_w)[0])
+        n_w = effective_tracks(z, dx, est.nperseg, band, weights=lambda n: fit_weights(n)[1]) if free_w else m
+        summary.update(Gd_n0_rel_se=fit.Gd_n0_rel_se * math.sqrt(m / n_gd),
+                       w_se=fit.w_se * math.sqrt(m / n_w),
+                       effective_tracks={"Gd_n0": n_gd, "w": n_w},
+                       centre_track=_centre_track_fit(s, band, args.fixed_w))
+        c = summary["centre_track"]
+        text = (f"{p}: Gd(n0) = {fit.Gd_n0:.4e} m^3 (+-{100 * summary['Gd_n0_rel_se']:.1f} %), "
+                f"w = {fit.w:.3f} (+-{summary['w_se']:.3f}), class {fit.iso_class}, band "
+                f"{band[0]:.3g}-{band[1]:.3g} cycles/m; the average of {m} tracks, worth about "
+                f"{n_gd:.1f} independent ones for Gd(n0) (neighbouring tracks are nearly one profile "
+                f"at long wavelengths).\nThe centre track alone (y = {c['y']:g} m; what `road plot` "
+                f"and `road generate` report): Gd(n0) = {c['Gd_n0']:.4e} m^3 (+-{100 * c['Gd_n0_rel_se']:.1f} %)"
+                f", w = {c['w']:.3f}")
+    _print(args, summary, text)
     return 0
+
+
+def _centre_track_fit(surf, band, fixed_w: bool) -> dict:
+    """The ISO fit of the track nearest y = 0 [m] in ``band``, as ``road plot`` shows it."""
+    from roadlib.metrics import fit_iso_psd, profile_psd
+
+    y = float(surf.y[np.argmin(np.abs(surf.y))])
+    fit = fit_iso_psd(profile_psd(surf.track(y), surf.dx), band=band, w=2.0 if fixed_w else None)
+    return {"y": y, **fit.to_dict()}
 
 
 def cmd_iri(args) -> int:
@@ -326,7 +357,9 @@ def cmd_plot(args) -> int:
         raise EroadInputError(f"--track {track:g} m is outside the road {s.y[0]:g}..{s.y[-1]:g} m")
     fit = plot_road(s, out, track=track)
     summary = {"file": str(p), "png": str(out), "track": track, **fit}
-    _print(args, summary, f"wrote {out}")
+    _print(args, summary, f"wrote {out}: track y = {track:g} m, Gd(n0) = {fit['Gd_n0']:.4e} m^3, "
+           f"w = {fit['w']:.3f}, class {fit['class']} (one track; `road psd` averages all the "
+           "road's tracks unless --track)")
     return 0
 
 
