@@ -33,6 +33,7 @@ COMMAND_MODULES = (
     "inverse.cli",
     "studies.cli",
     "studies.cli_pantograph",
+    "studies.cli_pantograph_contact",
     "studies.reproduce",
     "diagnosis.cli",
 )

@@ -11,7 +11,7 @@ from eroad.cli import main
 #: module that fails to import with ModuleNotFoundError, so a lost package would
 #: silently drop its commands from the list)
 DOCUMENTED_COMMANDS = ("road", "simulate", "effects", "vehicle", "modes", "data", "synth", "invert", "runs",
-                       "study", "reproduce", "diagnose")
+                       "study", "pantograph-contact", "reproduce", "diagnose")
 
 
 def _listed_commands(help_text: str) -> list[str]:

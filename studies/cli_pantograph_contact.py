@@ -1,0 +1,99 @@
+"""Command ``eroad pantograph-contact``: the e-tractor's pantograph under a contact line.
+
+``eroad pantograph-contact --road FILE --out DIR [--speed-kmh 80] [--duration 30]``
+drives the tractor over the road, feeds the DCDC-top motion into the pantograph in
+contact with the line and writes ``DIR/pantograph_contact/<run-id>/`` with the contact
+force statistics (also with the base at rest), the lateral offset against the head
+width, ``data/contact.npz``, ``figures/contact.png`` and ``summary.json``
+(:func:`studies.pantograph_contact.run_pantograph_contact`).  ``--railway-reference``
+adds (or, without ``--road``, runs only) the railway reference case at 250 and 300 km/h.
+See ``docs/pantograph_contact.md``.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+
+__all__ = ["register"]
+
+
+def _positive(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
+    return v
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``eroad pantograph-contact`` to the top-level subparsers."""
+    p = subparsers.add_parser(
+        "pantograph-contact", help="pantograph on the e-tractor under a contact line: "
+        "contact force statistics",
+        description="Drive the e-tractor over a road, feed the pantograph-base motion into "
+        "a three-mass pantograph in penalty contact with a finite-element contact line, "
+        "and report EN 50367-style contact force statistics (mean, sd, Fm +/- 3 sd, "
+        "min, max, contact loss) and the lateral offset against the head width.")
+    p.add_argument("--road", metavar="FILE", help="road file (.npz or .crg)")
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="results root; the run goes to DIR/pantograph_contact/<run-id>/")
+    p.add_argument("--speed-kmh", type=_positive, default=80.0, help="speed [km/h] (default 80)")
+    p.add_argument("--duration", type=_positive, default=30.0,
+                   help="drive [s] (default 30; shortened to what the road covers)")
+    p.add_argument("--line", default="truck_ohl",
+                   help="contact line id or TOML file (default truck_ohl)")
+    p.add_argument("--pantograph", default="truck",
+                   help="pantograph id or TOML file (default truck)")
+    p.add_argument("--chassis", choices=("flexible", "rigid"), default="flexible")
+    p.add_argument("--frame-factor", type=_positive, default=1.0,
+                   help="frame stiffness factor [-] (default 1)")
+    p.add_argument("--mount-factor", type=_positive, default=1.0,
+                   help="DCDC mount stiffness factor [-] (default 1)")
+    p.add_argument("--dt", type=_positive, default=1e-3, help="contact time step [s] (default 1e-3)")
+    p.add_argument("--no-compare", action="store_true",
+                   help="skip the run with the pantograph base at rest")
+    p.add_argument("--railway-reference", action="store_true",
+                   help="also run the railway reference case (250 and 300 km/h, about 1 min)")
+    p.add_argument("--json", action="store_true", help="print summary.json")
+    p.set_defaults(func=_run)
+
+
+def _fmt(st: dict) -> str:
+    return (f"mean {st['mean']:.1f} N, sd {st['sd']:.1f} N, Fm-3sd {st['stat_min']:.1f} N, "
+            f"Fm+3sd {st['stat_max']:.1f} N, min {st['actual_min']:.1f} N, "
+            f"max {st['actual_max']:.1f} N, loss {st['loss_percent']:.2f} %")
+
+
+def _run(args: argparse.Namespace) -> int:
+    import sys
+
+    from studies.pantograph_contact import run_pantograph_contact
+
+    kw = {}
+    if args.road is not None:
+        kw = dict(speed_kmh=args.speed_kmh, duration=args.duration, line=args.line,
+                  pantograph=args.pantograph, chassis=args.chassis,
+                  frame_factor=args.frame_factor, mount_factor=args.mount_factor,
+                  dt=args.dt, compare_static=not args.no_compare)
+    s = run_pantograph_contact(args.road, args.out, reference=args.railway_reference,
+                               command=sys.argv, **kw)
+    if args.json:
+        print(json.dumps(s, indent=2, default=str))
+        return 0
+    if "contact" in s:
+        print(f"contact force (drive):      {_fmt(s['contact'])}")
+        if s.get("contact_base_at_rest"):
+            print(f"contact force (base still): {_fmt(s['contact_base_at_rest'])}")
+        lat = s["lateral"]
+        print(f"lateral offset: max {1e3 * lat['max_abs_offset']:.1f} mm of half-width "
+              f"{1e3 * lat['half_width']:.0f} mm (margin {1e3 * lat['margin']:.1f} mm)")
+        w = s["wall"]
+        print(f"wall: vehicle {w['vehicle_s']:.1f} s, contact {w['contact_s']:.1f} s")
+    for kmh, c in (s.get("reference") or {}).get("cases", {}).items():
+        print(f"reference {kmh} km/h: {_fmt(c['stats'])}; inside published ranges: "
+              f"{c['inside']}")
+    print(s["path"])
+    return 0
