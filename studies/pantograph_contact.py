@@ -261,6 +261,11 @@ def run_pantograph_contact(road_path: str | Path | None, out_root: str | Path = 
 
     if road_path is None and not reference:
         raise EroadInputError("give a road file (--road) or ask for the railway reference")
+    if road_path is not None:  # refuse bad line / pantograph ids before reading anything
+        from vehicles.pantograph_model import load_pantograph
+
+        load_line(kw.get("line", "truck_ohl"))
+        load_pantograph(kw.get("pantograph", "truck"))
     road = None
     config: dict[str, Any] = {"reference": bool(reference), **{k: v for k, v in kw.items()}}
     if road_path is not None:

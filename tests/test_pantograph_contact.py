@@ -135,3 +135,13 @@ def test_cli_needs_a_road_or_reference(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2 and "not found" in err and "Traceback" not in err
     assert not any(tmp_path.iterdir())  # nothing written for a refused input
+
+
+def test_cli_unknown_line_refused_before_any_run_folder(tmp_path, capsys):
+    road = tmp_path / "road.npz"
+    road.write_bytes(b"")  # never read: the line id is checked first
+    code = main(["pantograph-contact", "--out", str(tmp_path / "out"), "--road", str(road),
+                 "--line", "no_such_line"])
+    err = capsys.readouterr().err
+    assert code == 2 and "unknown contact line" in err
+    assert not (tmp_path / "out").exists()
