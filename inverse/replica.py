@@ -1,0 +1,594 @@
+"""The road replica: the left and right wheel-track profiles a drive went over,
+reconstructed from its response channels and speed (issue 17).
+
+What it is for: the actual profiles z_L(x), z_R(x) under the two wheel tracks on a
+distance grid -- for replaying a drive, driving the identified road in another
+simulator, IRI -- where :mod:`inverse.pipeline` only identifies the road's
+statistics.  What it is not: a statistical road model (no phases are drawn; where
+the vehicle cannot sense the road the replica is the prior's mean, i.e. smooth, and
+is marked not identified), nor a nonlinear estimator (nonlinear effects are left out
+of the linear model, as in :func:`inverse.linear_features.linear_model_for`).
+
+Method (docs/replica.md gives the reasons)
+------------------------------------------
+Input estimation on the linearised vehicle (:func:`vehicles.linear.linear_model`),
+in the time domain, exact for a varying speed:
+
+* unknowns: the two track profiles on a distance grid ``x_j = x_0 + j dx``
+  (dx = 0.1 m), x measured from the first axle's position at the first sample;
+* the road height under tyre c at time t is the linear interpolation of its side's
+  profile at ``s(t) + x_c`` (s the distance travelled, the trapezoid integral of the
+  speed channel; x_c <= 0 the axle position), its rate the profile slope times the
+  speed -- the numbers ``vehicles.simulate.road_under_tyres`` feeds the simulator;
+  every axle crosses the same profile with its wheelbase delay by construction;
+* the state-space form of the linear model (``LinearModel.state_space``) is
+  discretised with a first-order hold at ``substeps`` times the sample rate and
+  diagonalised, so one evaluation of the map G: profiles -> channels is one
+  first-order recursion per mode (``scipy.signal.lfilter``); its adjoint runs the
+  same recursions backwards.  The simulation starts at rest ``runin_s`` before the
+  record (speed held at its first value), so the unknown initial state is explained
+  by the profile behind the record rather than ignored;
+* estimate: ``z = argmin sum_c ||(y_c - (G z)_c) / sigma_c||^2 + alpha ||D z||^2 +
+  eps ||z||^2`` with D the first difference of each track: the maximum a posteriori
+  estimate under white sensor noise (standard deviation sigma_c per channel) and a
+  road prior whose slope is white -- the ISO 8608 shape with waviness w = 2, for
+  which ``alpha = 1 / var(z_{j+1} - z_j) = 2 / (G_s dx)``, G_s = (2 pi n0)^2 Gd(n0)
+  the one-sided slope PSD.  Solved by conjugate gradients on the normal equations.
+* sigma_c: given (``noise_sd``) or estimated from the top of each channel's
+  spectrum (:func:`inverse.features.estimate_noise_psd`).
+* alpha (the road level Gd(n0)) and a per-channel model-error floor are chosen by
+  the data: empirical Bayes, i.e. maximising the marginal likelihood by EM --
+  :func:`reconstruct` docstring.
+
+Identified band: per speed, the regularised resolution of each track at spatial
+frequency n in the constant-speed frequency-domain picture,
+``R(n) = diag[(H^H W H + alpha |d(n)|^2)^-1 H^H W H]`` with H from
+``LinearModel.track_frf`` at f = n v (wheelbase delays included), W the channel
+weights times the number of samples per metre, d(n) the first difference's
+transfer function; wavelengths where R >= ``RESOLUTION_MIN`` on both tracks are
+identified (:func:`resolution`).
+
+Units: SI; x and wavelengths [m], spatial frequency [cycles/m], heights [m].
+"""
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sps
+from scipy.signal import cont2discrete, lfilter
+
+from eroad.errors import EroadInputError
+
+#: distance grid step of the replica [m] (issue: <= 0.1 m)
+DX = 0.1
+#: integration sub-steps per sample of the discretised linear model
+SUBSTEPS = 1
+#: simulated run-in before the record [s] (the vehicle starts at rest)
+RUNIN_S = 2.0
+#: regularised resolution above which a wavelength counts as identified [-]
+RESOLUTION_MIN = 0.5
+#: response quantities used (DCDC channels are not wheel-station responses)
+RESPONSE_QUANTITIES = ("susp_disp", "axle_acc", "body_acc")
+#: initial road level Gd(n0) [m^3] of the prior (ISO class C centre); EM moves it
+GD0_START = 256e-6
+#: ISO reference spatial frequency [cycles/m]
+N0 = 0.1
+#: tiny ridge on the heights (the mean height is invisible to the vehicle) [-, relative to alpha]
+EPS_REL = 1e-6
+
+
+def response_channels(names) -> list:
+    """The wheel-station response channels among ``names`` (susp_disp, axle_acc, body_acc)."""
+    return [c for c in names if c.rsplit("_", 1)[0] in RESPONSE_QUANTITIES]
+
+
+def axle_of(channel: str) -> int:
+    """Axle number of a wheel-station channel name (``axle_acc_2L`` -> 2)."""
+    return int(channel.rsplit("_", 1)[1][:-1])
+
+
+# --------------------------------------------------------------------------- the linear map
+class ReplicaOperator:
+    """The linear map G from the two track profiles to the response channels.
+
+    Parameters
+    ----------
+    lm : vehicles.linear.LinearModel
+    time : (T,) array
+        Record time [s], uniform.
+    speed : (T,) array
+        Speed [m/s], > 0.
+    channels : list of str
+        Output channels (names of ``lm.outputs``).
+    dx : float
+        Profile grid step [m].
+    substeps : int
+        Integration steps per sample.
+    runin_s : float
+        Run-in before the record [s].
+
+    Attributes
+    ----------
+    x : (N,) array
+        Profile grid [m], 0 = first axle at the first sample.
+    n_grid : int
+        N; the unknown vector is ``[z_L (N), z_R (N)]``.
+    covered : (N,) bool
+        Grid points some tyre runs over during the record (not only in the run-in).
+    """
+
+    def __init__(self, lm, time, speed, channels, dx: float = DX, substeps: int = SUBSTEPS,
+                 runin_s: float = RUNIN_S):
+        time = np.asarray(time, float)
+        speed = np.asarray(speed, float)
+        self.lm, self.channels, self.dx = lm, list(channels), float(dx)
+        self.fs = 1.0 / float(np.median(np.diff(time)))
+        sub = int(substeps)
+        T = time.size
+        n_run = int(round(runin_s * self.fs))
+        h = 1.0 / (self.fs * sub)
+        nf = (n_run + T - 1) * sub + 1
+        self.i_out = n_run * sub + np.arange(T) * sub
+        tf = (np.arange(nf) - n_run * sub) * h
+        vf = np.interp(tf, time - time[0], speed)       # run-in: the first speed held
+        sf = np.concatenate([[0.0], np.cumsum(0.5 * (vf[1:] + vf[:-1]) * h)])
+        sf -= sf[n_run * sub]                           # s = 0 at the first sample
+        self.s_record = sf[self.i_out]
+        xs = np.array([c["x"] for c in lm.contacts], float)
+        sides = [0 if c["side"] == "L" else 1 for c in lm.contacts]
+        j0 = math.floor((sf[0] + xs.min()) / dx) - 2
+        j1 = math.ceil((sf[-1] + xs.max()) / dx) + 2
+        N = j1 - j0 + 1
+        self.x = (j0 + np.arange(N)) * dx
+        self.n_grid = N
+        nc = len(xs)
+        rows, cols, vals = [], [], []
+        ii = np.arange(nf)
+        covered = np.zeros(N, bool)
+        for c in range(nc):
+            pos = (sf + xs[c] - self.x[0]) / dx
+            j = np.clip(np.floor(pos).astype(int), 0, N - 2)
+            fr = pos - j
+            off = sides[c] * N
+            rows += [c * nf + ii, c * nf + ii, (nc + c) * nf + ii, (nc + c) * nf + ii]
+            cols += [off + j, off + j + 1, off + j, off + j + 1]
+            vals += [1.0 - fr, fr, -vf / dx, vf / dx]
+            jr = j[self.i_out]
+            covered[np.arange(jr.min(), jr.max() + 2)] = True
+        self.covered = covered
+        self.Mu = sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                                 shape=(2 * nc * nf, 2 * N))
+        self.nf, self.nc = nf, nc
+        # continuous state space x = [q, q'], u = [z_r, z_r'] -> outputs
+        A, B = lm.state_space()
+        n = lm.n_dof
+        C = np.zeros((len(self.channels), 2 * n))
+        Dm = np.zeros((len(self.channels), B.shape[1]))
+        for k, name in enumerate(self.channels):
+            o = lm.output(name)
+            if o.order == 0:
+                C[k, :n] = o.row
+            else:
+                C[k] = o.row @ A[n:, :]
+                Dm[k] = o.row @ B[n:, :]
+        Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, Dm), h, method="foh")
+        lam, V = np.linalg.eig(Ad)
+        Vi = np.linalg.inv(V)
+        # conjugate pairs: keep the member with Im > 0 (weight 2), real modes weight 1
+        keep = lam.imag > 1e-12 * np.abs(lam) if np.any(lam.imag > 0) else np.zeros(lam.size, bool)
+        real = np.abs(lam.imag) <= 1e-12 * np.abs(lam)
+        sel = keep | real
+        wt = np.where(real[sel], 1.0, 2.0)
+        self.lam = lam[sel]
+        self.Bm = Vi[sel] @ Bd
+        self.Cm = (Cd @ V[:, sel]) * wt[None, :]
+        self.Dd = Dd
+
+    @property
+    def n_unknowns(self) -> int:
+        return 2 * self.n_grid
+
+    def _modal(self, g: np.ndarray) -> np.ndarray:
+        out = np.empty_like(g)
+        for m, lm_ in enumerate(self.lam):
+            out[m] = lfilter([0.0, 1.0], [1.0, -lm_], g[m])
+        return out
+
+    def forward(self, z: np.ndarray) -> np.ndarray:
+        """Channels (n_channels, T) [channel units] for profiles ``z`` = [z_L, z_R] (2N,) [m]."""
+        u = (self.Mu @ np.asarray(z, float)).reshape(2 * self.nc, self.nf)
+        g = self.Bm.real @ u + 1j * (self.Bm.imag @ u)
+        xi = self._modal(g)[:, self.i_out]
+        return self.Cm.real @ xi.real - self.Cm.imag @ xi.imag + self.Dd @ u[:, self.i_out]
+
+    def adjoint(self, Y: np.ndarray) -> np.ndarray:
+        """Adjoint of :meth:`forward`: (n_channels, T) -> (2N,)."""
+        Y = np.asarray(Y, float)
+        ub = np.zeros((2 * self.nc, self.nf))
+        ub[:, self.i_out] = self.Dd.T @ Y
+        s = np.zeros((self.lam.size, self.nf), complex)
+        s[:, self.i_out] = self.Cm.conj().T @ Y
+        eta = np.empty_like(s)
+        for m, lm_ in enumerate(self.lam):
+            eta[m] = lfilter([0.0, 1.0], [1.0, -np.conj(lm_)], s[m, ::-1])[::-1]
+        ub += self.Bm.real.T @ eta.real + self.Bm.imag.T @ eta.imag
+        return self.Mu.T @ ub.ravel()
+
+    def profile_input(self, z_left, z_right=None) -> tuple:
+        """Road height and rate under each tyre on the fine time grid (for checks)."""
+        z = np.concatenate([z_left, z_left if z_right is None else z_right])
+        u = (self.Mu @ z).reshape(2 * self.nc, self.nf)
+        return u[:self.nc], u[self.nc:]
+
+
+def first_difference(N: int) -> sps.csr_matrix:
+    """First difference of each of the two tracks, (2(N-1), 2N)."""
+    d = sps.diags([-np.ones(N - 1), np.ones(N - 1)], [0, 1], shape=(N - 1, N))
+    return sps.block_diag([d, d]).tocsr()
+
+
+# --------------------------------------------------------------------------- resolution / band
+def resolution(lm, channels, sigma, speed: float, n, alpha: float, dx: float = DX, fs: float = 200.0):
+    """Regularised resolution of each track per spatial frequency at constant speed.
+
+    ``R = diag[(H^H W H + alpha |d|^2 I)^-1 H^H W H]`` with H (n_ch, 2) from
+    ``LinearModel.track_frf`` at f = n v, W = diag(1 / sigma_c^2) times the samples per
+    grid step (fs dx / v, so that data and prior are counted per metre alike) and
+    |d|^2 = |2 sin(pi n dx)|^2 the first difference's power gain.
+
+    Parameters
+    ----------
+    lm : LinearModel
+    channels : list of str
+    sigma : array (n_ch,)
+        Noise (plus model-error) standard deviation per channel [channel unit].
+    speed : float
+        [m/s].
+    n : array
+        Spatial frequencies [cycles/m], > 0.
+    alpha : float
+        Prior weight on the squared first differences [1/m^2].
+
+    Returns
+    -------
+    (n_f, 2) array
+        Resolution of the left and right track in [0, 1].
+    """
+    n = np.asarray(n, float)
+    H = lm.track_frf(n * speed, speed, channels)                 # (nf, nch, 2)
+    w = (fs * dx / speed) / np.asarray(sigma, float) ** 2
+    HWH = np.einsum("foa,o,fob->fab", H.conj(), w, H)
+    d2 = (2 * np.sin(np.pi * n * dx)) ** 2
+    Rg = HWH + alpha * d2[:, None, None] * np.eye(2)[None]
+    R = np.linalg.solve(Rg, HWH)
+    return np.clip(np.real(np.stack([R[:, 0, 0], R[:, 1, 1]], axis=1)), 0.0, 1.0)
+
+
+def identified_band(lm, channels, sigma, speed: float, alpha: float, dx: float = DX,
+                    fs: float = 200.0, n_points: int = 240) -> tuple:
+    """Shortest and longest identified wavelength [m] at one speed (both tracks R >= 0.5).
+
+    The band is the contiguous run of identified frequencies that holds the most
+    grid points of a logarithmic grid from 1/(200 m) to the grid's Nyquist 1/(2 dx);
+    (nan, nan) when no frequency is identified.
+    """
+    n = np.geomspace(1 / 200.0, 0.5 / dx, n_points)
+    R = resolution(lm, channels, sigma, speed, n, alpha, dx, fs)
+    ok = np.all(R >= RESOLUTION_MIN, axis=1)
+    if not ok.any():
+        return float("nan"), float("nan")
+    best, cur, start, bs = 0, 0, 0, 0
+    for i, v in enumerate(ok):
+        if v:
+            if cur == 0:
+                start = i
+            cur += 1
+            if cur > best:
+                best, bs = cur, start
+        else:
+            cur = 0
+    return float(1.0 / n[bs + best - 1]), float(1.0 / n[bs])
+
+
+# --------------------------------------------------------------------------- the estimate
+@dataclass
+class Replica:
+    """A reconstructed pair of wheel tracks.
+
+    Attributes
+    ----------
+    x : (N,) array
+        Distance [m] (0: first axle at the first sample).
+    z_left, z_right : (N,) arrays
+        Track heights [m].
+    covered : (N,) bool
+        Grid points a tyre ran over during the record.
+    lambda_min, lambda_max : (N,) arrays
+        Identified wavelength band at each point [m] (from the speed at which the
+        vehicle crossed it; nan outside ``covered``).
+    channels : list of str
+        Channels used.
+    sigma : dict
+        Channel -> standard deviation used as its noise (sensor noise, raised to the
+        residual's where the model misses more) [unit].
+    sigma_sensor : dict
+        Channel -> sensor-noise standard deviation (given or estimated) [unit].
+    alpha : float
+        Prior weight [1/m^2]; ``gd0`` the road level it stands for [m^3].
+    fitted : dict
+        Channel -> (T,) the linear model's response on the replica [unit].
+    info : dict
+        Iterations, timings, EM history.
+    """
+
+    x: np.ndarray
+    z_left: np.ndarray
+    z_right: np.ndarray
+    covered: np.ndarray
+    lambda_min: np.ndarray
+    lambda_max: np.ndarray
+    channels: list
+    sigma: dict
+    sigma_sensor: dict
+    alpha: float
+    gd0: float
+    fitted: dict
+    info: dict = field(default_factory=dict)
+    operator: object = None
+
+    def predict(self, channels) -> dict:
+        """Responses of the linear model on the replica for any channels (e.g. held out)."""
+        return _predict(self.operator, self, list(channels))
+
+
+def _predict(op: ReplicaOperator, rep: Replica, channels) -> dict:
+    other = ReplicaOperator(op.lm, op._time, op._speed, channels, op.dx, op._substeps, op._runin_s)
+    Y = other.forward(np.concatenate([rep.z_left, rep.z_right]))
+    return {c: Y[k] for k, c in enumerate(channels)}
+
+
+def alpha_of_gd0(gd0: float, dx: float = DX) -> float:
+    """Prior weight for a road of level Gd(n0) with w = 2: 1 / var(first difference)."""
+    gs = (2 * np.pi * N0) ** 2 * gd0          # one-sided slope PSD [m]
+    return 2.0 / (gs * dx)
+
+
+def gd0_of_alpha(alpha: float, dx: float = DX) -> float:
+    return 2.0 / (alpha * dx) / (2 * np.pi * N0) ** 2
+
+
+def _cg(apply_A, b, x0, tol: float, max_iter: int, precond=None):
+    """Conjugate gradients for a symmetric positive definite operator."""
+    x = x0.copy()
+    r = b - apply_A(x)
+    zr = precond(r) if precond else r
+    p = zr.copy()
+    rz = r @ zr
+    bn = np.linalg.norm(b) or 1.0
+    it = 0
+    for it in range(1, max_iter + 1):
+        Ap = apply_A(p)
+        a = rz / (p @ Ap)
+        x += a * p
+        r -= a * Ap
+        if np.linalg.norm(r) <= tol * bn:
+            break
+        zr = precond(r) if precond else r
+        rz_new = r @ zr
+        p = zr + (rz_new / rz) * p
+        rz = rz_new
+    return x, it, float(np.linalg.norm(r) / bn)
+
+
+def _fourier_preconditioner(lm, names, sig, speed, alpha, eps, N, dx, fs, covered, v_local):
+    """Approximate inverse of the normal operator: the constant-speed (median speed)
+    frequency-domain picture, a 2x2 matrix per spatial frequency of the grid's FFT
+    (circulant approximation; only speeds CG up, never changes the solution)."""
+    n = np.fft.rfftfreq(N, dx)
+    n1 = n.copy()
+    n1[0] = n[1]
+    H = lm.track_frf(n1 * speed, speed, names)
+    w = (fs * dx / speed) / np.asarray(sig, float) ** 2
+    HWH = np.einsum("foa,o,fob->fab", H.conj(), w, H)
+    d2 = (2 * np.sin(np.pi * n * dx)) ** 2
+    floor = max(eps, alpha * (2 * np.sin(np.pi * n[1] * dx)) ** 2)
+    P = np.linalg.inv(HWH + (alpha * d2 + floor)[:, None, None] * np.eye(2)[None])
+
+    cov = np.asarray(covered, bool)
+    scale = np.sqrt(np.asarray(v_local, float) / speed)    # data per metre ~ 1 / local speed
+    unc = np.flatnonzero(~cov)
+    if unc.size:   # where no tyre runs during the record only the prior acts: its exact inverse
+        from scipy.sparse.linalg import splu
+
+        m = unc.size
+        d = sps.diags([-np.ones(m - 1), np.ones(m - 1)], [0, 1], shape=(m - 1, m))
+        lu = splu((alpha * (d.T @ d) + floor * sps.eye(m)).tocsc())
+
+    def apply(r):
+        r2 = r.reshape(2, N)
+        Z = np.fft.rfft(np.where(cov, r2 * scale, 0.0), axis=1)             # (2, nf)
+        out = np.fft.irfft(np.einsum("fab,bf->af", P, Z), N, axis=1) * scale
+        out[:, ~cov] = 0.0
+        if unc.size:
+            out[:, unc] = lu.solve(np.ascontiguousarray(r2[:, unc].T)).T
+        return out.ravel()
+    return apply
+
+
+def noise_sd(channels: dict, fs: float, given: dict | None = None) -> dict:
+    """Sensor-noise standard deviation per channel: given, else from the top of its
+    spectrum (:func:`inverse.features.estimate_noise_psd`, white: sd^2 = PSD fs / 2)."""
+    from inverse.features import estimate_noise_psd
+
+    out = {}
+    for c, y in channels.items():
+        if given and c in given:
+            out[c] = float(given[c])
+        else:
+            out[c] = float(math.sqrt(estimate_noise_psd(y, fs) * 0.5 * fs))
+        if not (out[c] > 0 and math.isfinite(out[c])):
+            out[c] = 1e-12 + 1e-6 * float(np.std(y))
+    return out
+
+
+def _local_speed(op: ReplicaOperator, lm, speed) -> np.ndarray:
+    """Mean speed [m/s] at which the axles crossed each grid point (interpolated
+    between crossings, held beyond them)."""
+    N, dx = op.n_grid, op.dx
+    acc = np.zeros(N)
+    cnt = np.zeros(N)
+    for xc in np.unique([c["x"] for c in lm.contacts]):
+        j = np.clip(np.round((op.s_record + xc - op.x[0]) / dx).astype(int), 0, N - 1)
+        np.add.at(acc, j, speed)
+        np.add.at(cnt, j, 1)
+    idx = np.flatnonzero(cnt > 0)
+    return np.interp(op.x, op.x[idx], acc[idx] / cnt[idx])
+
+
+def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, dx: float = DX,
+                substeps: int = SUBSTEPS, runin_s: float = RUNIN_S, em_rounds: int = 3,
+                alpha: float | None = None, tol: float = 1e-6, max_iter: int = 120, first_iter: int = 40,
+                progress=None) -> Replica:
+    """Reconstruct the two wheel tracks from response channels (module docstring).
+
+    Regularisation weight and channel weights (DECISION, docs/replica.md): empirical
+    Bayes by EM.  Start with sigma_c the sensor noise and alpha for an ISO class C road;
+    each round solves for z, then sets
+
+    * sigma_c^2 = max(sensor noise^2, mean squared residual of channel c): a channel
+      the model cannot follow (model gap, nonlinearity) is down-weighted to what it
+      can explain, never below its sensor noise;
+    * alpha = 1 / (mean squared first difference of z over the covered grid + its
+      posterior variance), the posterior variance from the constant-speed
+      frequency-domain picture at the median speed (per frequency
+      ``(H^H W H + alpha |d|^2)^-1``, see :func:`resolution`).
+
+    ``em_rounds`` solves (3: the sensor-noise start, then two with updated weights;
+    the first rounds stop after ``first_iter`` CG iterations, they only set the weights).
+    A given ``alpha`` skips its update.
+
+    Parameters
+    ----------
+    lm : LinearModel
+    time, speed : (T,) arrays
+        [s], [m/s].
+    channels : dict
+        Channel name -> (T,) measured signal [SI].
+    noise : dict, optional
+        Channel -> sensor-noise sd [unit]; others estimated.
+
+    Returns
+    -------
+    Replica
+    """
+    t0 = _time.perf_counter()
+    names = list(channels)
+    if not names:
+        raise EroadInputError("replica: no response channel to reconstruct from")
+    speed = np.asarray(speed, float)
+    if speed.size != np.asarray(time).size:
+        raise EroadInputError("replica: speed and time differ in length")
+    if not np.all(np.isfinite(speed)) or np.min(speed) <= 0.5:
+        raise EroadInputError("replica: needs a moving vehicle (speed > 0.5 m/s throughout)")
+    op = ReplicaOperator(lm, time, speed, names, dx, substeps, runin_s)
+    op._time, op._speed, op._substeps, op._runin_s = np.asarray(time, float), speed, substeps, runin_s
+    Y = np.array([np.asarray(channels[c], float) for c in names])
+    Y = Y - Y.mean(axis=1, keepdims=True)          # static offsets (sensor zero) are not road
+    fs = op.fs
+    sensor = noise_sd(dict(zip(names, Y)), fs, noise)
+    sig0 = np.array([sensor[c] for c in names])
+    sig = sig0.copy()
+    N = op.n_grid
+    Dm = first_difference(N)
+    DtD = (Dm.T @ Dm).tocsr()
+    v_loc = _local_speed(op, lm, speed)
+    fixed_alpha = alpha is not None
+    al = float(alpha) if fixed_alpha else alpha_of_gd0(GD0_START, dx)
+    z = np.zeros(2 * N)
+    hist = []
+    v_med = float(np.median(speed))
+    n_fft = np.fft.rfftfreq(4096, dx)[1:]
+    total_it = 0
+    rounds = max(1, int(em_rounds))
+    for rnd in range(rounds):
+        last = rnd == rounds - 1
+        w = 1.0 / sig ** 2
+        eps = EPS_REL * al
+
+        def normal(v, w=w, al=al, eps=eps):
+            return op.adjoint(w[:, None] * op.forward(v)) + al * (DtD @ v) + eps * v
+
+        b = op.adjoint(w[:, None] * Y)
+        z, it, rel = _cg(normal, b, z, tol, max_iter if last else first_iter)
+        total_it += it
+        R = Y - op.forward(z)
+        ms = np.mean(R ** 2, axis=1)
+        entry = {"round": rnd, "alpha": al, "gd0": gd0_of_alpha(al, dx), "cg_iter": it, "cg_rel_res": rel,
+                 "chi2_per_sample": float(np.mean(ms / sig ** 2))}
+        hist.append(entry)
+        if progress:
+            progress(f"replica round {rnd}: alpha {al:.3g} (Gd(n0) {entry['gd0']:.3g} m^3), "
+                     f"CG {it} it, chi2/sample {entry['chi2_per_sample']:.2f}")
+        if last:
+            break
+        # EM updates
+        sig = np.sqrt(np.maximum(sig0 ** 2, ms))
+        cov = np.concatenate([op.covered[:-1], op.covered[:-1]])
+        dz = (Dm @ z)[cov]
+        # posterior variance of a first difference, constant-speed picture (per metre)
+        H = lm.track_frf(n_fft * v_med, v_med, names)
+        wpm = (fs * dx / v_med) / sig ** 2
+        HWH = np.einsum("foa,o,fob->fab", H.conj(), wpm, H)
+        d2 = (2 * np.sin(np.pi * n_fft * dx)) ** 2
+        P = np.linalg.inv(HWH + al * d2[:, None, None] * np.eye(2)[None])
+        post = float(np.mean(d2 * np.real(P[:, 0, 0] + P[:, 1, 1]) / 2.0))
+        if not fixed_alpha:
+            al = 1.0 / (float(np.mean(dz ** 2)) + post)
+    # identified band per grid point from the speed at which it was crossed
+    fitted = op.forward(z)
+    speeds = np.quantile(speed, [0.05, 0.25, 0.5, 0.75, 0.95])
+    bands = np.array([identified_band(lm, names, sig, v, al, dx, fs) for v in speeds])
+    v_at = v_loc
+    lam_min = np.interp(v_at, speeds, bands[:, 0])
+    lam_max = np.interp(v_at, speeds, bands[:, 1])
+    lam_min[~op.covered] = np.nan
+    lam_max[~op.covered] = np.nan
+    info = {"cg_iterations": total_it, "em": hist, "wall_s": _time.perf_counter() - t0,
+            "n_unknowns": 2 * N, "n_samples": int(Y.size), "substeps": substeps, "runin_s": runin_s,
+            "speed_quantiles_mps": speeds.tolist(), "band_at_speed_m": bands.tolist(),
+            "linear_model_notes": list(lm.meta.get("notes", []))}
+    return Replica(x=op.x, z_left=z[:N], z_right=z[N:], covered=op.covered, lambda_min=lam_min,
+                   lambda_max=lam_max, channels=names, sigma=dict(zip(names, sig.tolist())),
+                   sigma_sensor=sensor, alpha=al, gd0=gd0_of_alpha(al, dx),
+                   fitted={c: fitted[k] + 0.0 for k, c in enumerate(names)}, info=info, operator=op)
+
+
+# --------------------------------------------------------------------------- scoring helpers
+def band_filter(z, dx: float, band_m=(0.5, 20.0)) -> np.ndarray:
+    """Profile band-passed to wavelengths within ``band_m`` [m] (FFT mask, mean and
+    linear trend removed first)."""
+    z = np.asarray(z, float)
+    xx = np.arange(z.size)
+    z = z - np.polyval(np.polyfit(xx, z, 1), xx)
+    Z = np.fft.rfft(z)
+    n = np.fft.rfftfreq(z.size, dx)
+    keep = (n >= 1.0 / band_m[1]) & (n <= 1.0 / band_m[0])
+    return np.fft.irfft(Z * keep, z.size)
+
+
+def band_correlation(z_est, z_true, dx: float, band_m=(0.5, 20.0)) -> float:
+    """Correlation of two profiles on the same grid in a wavelength band [-]."""
+    a = band_filter(z_est, dx, band_m)
+    b = band_filter(z_true, dx, band_m)
+    return float(np.dot(a, b) / math.sqrt(np.dot(a, a) * np.dot(b, b)))
+
+
+def nrmse(pred, meas) -> float:
+    """RMS(pred - meas) / RMS(meas - mean) [-]."""
+    meas = np.asarray(meas, float)
+    m = meas - meas.mean()
+    p = np.asarray(pred, float) - np.mean(pred)
+    return float(np.sqrt(np.mean((p - m) ** 2)) / np.sqrt(np.mean(m ** 2)))

@@ -1,0 +1,131 @@
+"""The road replica (issue 17): inverse.replica and ``eroad replica``.
+
+Fast tests use the nominal truck's linear model on short constant-speed records; the
+null-drive check against a synthetic truth is marked slow.
+"""
+import numpy as np
+import pytest
+
+from inverse.replica import (ReplicaOperator, band_correlation, identified_band, reconstruct,
+                             resolution, response_channels)
+
+
+@pytest.fixture(scope="module")
+def lm():
+    from vehicles.linear import linear_model
+    return linear_model("dump_truck_8x4")
+
+
+def _record(T=8.0, fs=100.0, v=10.0):
+    t = np.arange(int(T * fs)) / fs
+    return t, np.full(t.size, v)
+
+
+def test_adjoint_is_exact(lm):
+    # <G z, Y> = <z, G^T Y> to rounding: the solver's gradients are exact
+    t, v = _record(4.0)
+    v = v + np.linspace(-2, 2, t.size)              # a varying speed
+    names = response_channels(lm.channel_names)
+    op = ReplicaOperator(lm, t, v, names)
+    rng = np.random.default_rng(1)
+    z = rng.standard_normal(op.n_unknowns)
+    Y = rng.standard_normal((len(names), t.size))
+    a, b = np.sum(op.forward(z) * Y), z @ op.adjoint(Y)
+    assert abs(a - b) <= 1e-10 * abs(a)
+
+
+def test_steady_state_sine_matches_track_frf_with_wheelbase_delay(lm):
+    # closed form: at constant speed a sine track z_L = sin(2 pi n x) gives, once the
+    # transient has died, y_c(t) = Im(H_cL(n v) exp(j 2 pi n s(t))) with H from
+    # LinearModel.track_frf, whose phases carry every axle's wheelbase delay.
+    # Tolerances (of the amplitude): 2 % for displacements and body accelerations --
+    # the linearly interpolated 0.1 m grid (a 5 m wave in 50 steps: 0.2 %), the
+    # first-order hold at 100 Hz, and what is left of the transient of the slowest mode
+    # (0.53 Hz, decay rate 0.15 1/s) after 6 s; 5 % for axle accelerations, which
+    # feel the tyre damping force c_t z' directly: the slope of the interpolated grid is
+    # a staircase, up to pi n dx = 6 % off the sine's slope at n = 0.2 cycles/m.
+    fs, v, n = 100.0, 10.0, 0.2
+    t, sp = _record(12.0, fs, v)
+    names = ["susp_disp_1L", "susp_disp_4L", "axle_acc_2L", "body_acc_3R", "axle_acc_4R"]
+    op = ReplicaOperator(lm, t, sp, names)
+    z = np.concatenate([np.sin(2 * np.pi * n * op.x), np.zeros(op.n_grid)])
+    Y = op.forward(z)
+    H = lm.track_frf([n * v], v, names)[0]              # (n_ch, 2)
+    late = t > 6.0
+    s = op.s_record[late]
+    for k, c in enumerate(names):
+        expect = np.imag(H[k, 0] * np.exp(2j * np.pi * n * s))
+        err = np.max(np.abs(Y[k, late] - expect)) / np.max(np.abs(expect))
+        tol = 0.05 if c.startswith("axle_acc") else 0.02
+        assert err < tol, (c, err)
+
+
+def test_each_axle_sees_the_track_after_its_wheelbase(lm):
+    # the road height fed to axle a's tyre at time t is axle 1's at t - (x_1 - x_a) / v
+    fs, v = 200.0, 8.0
+    t, sp = _record(5.0, fs, v)
+    op = ReplicaOperator(lm, t, sp, ["susp_disp_1L"])
+    rng = np.random.default_rng(3)
+    zl = np.cumsum(rng.standard_normal(op.n_grid)) * 1e-3
+    h, _ = op.profile_input(zl)
+    x = np.array([c["x"] for c in lm.contacts])
+    c1 = int(np.argmax(x))
+    for c in range(len(x)):
+        lag = (x[c1] - x[c]) / v * fs                       # samples
+        if abs(lag - round(lag)) > 1e-9:
+            continue
+        lag = int(round(lag))
+        assert np.allclose(h[c, lag:], h[c1, :h.shape[1] - lag], atol=1e-12)
+
+
+def test_recovers_a_road_driven_through_its_own_model(lm):
+    # closed loop: responses made by the same linear map from a known pair of tracks
+    # (sums of sines 1-10 m, different left and right), with small white noise, are
+    # inverted back.  Correlation in 0.5-20 m >= 0.995 and RMS error <= 5 % of the
+    # track's RMS on the covered stretch: what remains is the regularisation's
+    # smoothing near the 0.2 m grid Nyquist and the ends, where only one axle saw the road.
+    t, sp = _record(6.0, 100.0, 9.0)
+    names = response_channels(lm.channel_names)
+    op = ReplicaOperator(lm, t, sp, names)
+    rng = np.random.default_rng(7)
+    x = op.x
+    taper = np.clip(np.minimum(x - x[op.covered][0], x[op.covered][-1] - x) / 5.0, 0, 1)
+
+    def track():
+        lam = rng.uniform(1.0, 10.0, 12)
+        amp = 2e-3 * (lam / 5.0)
+        ph = rng.uniform(0, 2 * np.pi, 12)
+        return taper * np.sum(amp[:, None] * np.sin(2 * np.pi * x[None, :] / lam[:, None] + ph[:, None]), 0)
+
+    zl, zr = track(), track()
+    Y = op.forward(np.concatenate([zl, zr]))
+    sd = {c: (1e-6 if c.startswith("susp") else 1e-3) for c in names}
+    Yn = Y + np.array([sd[c] * rng.standard_normal(t.size) for c in names])
+    rep = reconstruct(lm, t, sp, dict(zip(names, Yn)), noise=sd, em_rounds=2, max_iter=150)
+    cov = rep.covered & (taper > 0.99)
+    for est, true in ((rep.z_left, zl), (rep.z_right, zr)):
+        assert band_correlation(est[cov], true[cov], 0.1) >= 0.995
+        e = est[cov] - true[cov]
+        e -= e.mean()
+        assert np.sqrt(np.mean(e ** 2)) <= 0.05 * np.std(true[cov])
+
+
+def test_band_marking_shrinks_with_noise(lm):
+    names = response_channels(lm.channel_names)
+    sig = np.array([1e-4 if c.startswith("susp") else 0.03 for c in names])
+    alpha = 2e5
+    lo, hi = identified_band(lm, names, sig, 10.0, alpha)
+    assert lo <= 0.5 and hi >= 20.0            # nominal sensors: 0.5-20 m is data
+    lo2, hi2 = identified_band(lm, names, sig * 1000, 10.0, alpha)
+    assert lo2 > lo and hi2 < 20.0             # 1000x noisier: only the axle-hop band stays
+    assert np.isnan(identified_band(lm, names, sig * 1e5, 10.0, alpha)[0])   # nothing sensed
+    # the resolution is a fraction, and it falls where the response to the road does
+    R = resolution(lm, names, sig * 1000, 10.0, np.array([1 / 5.0, 1.0]), alpha)
+    assert np.all((R >= 0) & (R <= 1)) and np.all(R[0] < R[1])
+
+
+def test_refuses_a_standing_vehicle(lm):
+    from eroad.errors import EroadInputError
+    t, sp = _record(2.0)
+    with pytest.raises(EroadInputError, match="moving vehicle"):
+        reconstruct(lm, t, sp * 0.0, {"susp_disp_1L": np.zeros(t.size)})
