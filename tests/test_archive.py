@@ -20,9 +20,28 @@ SCHEMA_KEYS = {"schema", "study", "run_id", "status", "command", "argv", "overri
                "host", "versions", "seed", "start_utc", "end_utc", "wall_s", "error", "extra"}
 
 
+def _tracked() -> set[str] | None:
+    """Files under results/ that git tracks (None without git): the committed runs."""
+    import subprocess
+    try:
+        r = subprocess.run(["git", "-C", str(RESULTS.parent), "ls-files", "results"],
+                           capture_output=True, text=True, timeout=30, check=True)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return set(r.stdout.split())
+
+
 def _committed_run_folders() -> set[Path]:
-    """Run folders under results/, found without the archive's code: each folder two
-    levels down, or a study folder that holds files only."""
+    """Committed run folders under results/, found without the archive's code: each
+    folder two levels down, or a study folder that holds files only (a folder some
+    other work is still writing, with nothing committed, is left out)."""
+    tracked = _tracked()
+    return {p for p in _run_folders()
+            if tracked is None or any(t.startswith(p.relative_to(RESULTS.parent).as_posix() + "/")
+                                      for t in tracked)}
+
+
+def _run_folders() -> set[Path]:
     out = set()
     for study in RESULTS.iterdir():
         if not study.is_dir() or study.name.startswith("."):
@@ -36,9 +55,8 @@ def test_runs_list_json_lists_every_run_folder_under_results(capsys, monkeypatch
     monkeypatch.chdir(RESULTS.parent)
     assert main(["runs", "list", "--json"]) == 0
     listed = {Path(r["path"]).resolve() for r in json.loads(capsys.readouterr().out)}
-    expected = {p.resolve() for p in _committed_run_folders()}
-    assert len(expected) >= 15      # 8 diagnosis_blind, 4 inverse_blind, 2 reproduce, effect_ranges
-    assert listed == expected
+    assert len(_committed_run_folders()) >= 15   # 8 diagnosis_blind, 4 inverse_blind, 2 reproduce, effect_ranges
+    assert listed == {p.resolve() for p in _run_folders()}
 
 
 @pytest.mark.parametrize("run", sorted(p.name for p in _committed_run_folders()))
@@ -53,7 +71,9 @@ def test_runs_show_has_no_none_field_on_a_committed_run(run, capsys, monkeypatch
 
 
 def test_committed_nested_run_json_files_share_the_schema():
-    files = list(RESULTS.rglob("run.json"))
+    tracked = _tracked()
+    files = [f for f in RESULTS.rglob("run.json")
+             if tracked is None or f.relative_to(RESULTS.parent).as_posix() in tracked]
     assert files
     for f in files:
         assert set(json.loads(f.read_text())) == SCHEMA_KEYS, f
