@@ -31,6 +31,7 @@ COMMAND_MODULES = (
     "vehicles.cli_modes",
     "drives.cli",
     "inverse.cli",
+    "inverse.cli_replica",
     "studies.cli",
     "studies.cli_pantograph",
     "studies.cli_pantograph_contact",

@@ -592,3 +592,260 @@ def nrmse(pred, meas) -> float:
     m = meas - meas.mean()
     p = np.asarray(pred, float) - np.mean(pred)
     return float(np.sqrt(np.mean((p - m) ** 2)) / np.sqrt(np.mean(m ** 2)))
+
+
+# --------------------------------------------------------------------------- the run folder
+#: run-folder format version of ``eroad replica``
+RUN_FORMAT = 1
+#: lateral road grid of the written 3D road [m] (tracks beyond |y| = HALF_GAP, blended between)
+ROAD_Y_HALF_WIDTH, ROAD_DY, HALF_GAP = 1.5, 0.1, 0.5
+
+
+def replica_surface(rep: Replica):
+    """The replica as a RoadSurface: z_L for y >= HALF_GAP, z_R for y <= -HALF_GAP, linear
+    in between (every tyre of the trucks here runs at |y| >= 0.76 m, so it sees its
+    track exactly).  DECISION: no lateral field is invented beside the tracks."""
+    from roadlib.surface import RoadSurface
+
+    y = np.round(np.arange(-ROAD_Y_HALF_WIDTH, ROAD_Y_HALF_WIDTH + 1e-9, ROAD_DY), 10)
+    a = np.clip((y + HALF_GAP) / (2 * HALF_GAP), 0.0, 1.0)            # 0 right .. 1 left
+    z = rep.z_right[:, None] * (1 - a[None, :]) + rep.z_left[:, None] * a[None, :]
+    meta = {"generator": "inverse.replica", "tracks": "z_left for y >= 0.5 m, z_right for y <= -0.5 m",
+            "x_origin": "first axle at the dataset's first sample"}
+    return RoadSurface(rep.x, y, z, meta)
+
+
+def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: bool = False,
+                argv=None, progress=None) -> dict:
+    """``eroad replica``: reconstruct, score the hold-out, write the run folder.
+
+    RUN (written into a temporary sibling folder and renamed into place, like
+    ``eroad invert``)::
+
+        tracks.csv          x_m, z_left_m, z_right_m, identified, lambda_min_m, lambda_max_m
+        iri.csv             track, segment_m (20, 100), start_m, end_m, iri_m_per_km
+        psd.csv             n_cpm, G_left_m3, G_right_m3 (Welch over the identified stretch)
+        road.npz, road.crg  the two tracks as a 3D road (replica_surface)
+        figures/replica_time.png, replica_psd.png, replica_tracks.png
+        summary.json, config.toml, run.json
+
+    Parameters
+    ----------
+    dataset : str or Path
+    out : str or Path
+    effects : dict, optional
+        Effects of the linear model (nonlinear ones are left out, as in the linear fit).
+    noise_sd : dict, optional
+        Channel or quantity -> sensor noise sd [SI]; the rest estimated.
+    holdout : int or None
+        Axle whose channels are left out of a second reconstruction and predicted
+        from it (validation); None: none.
+    """
+    import datetime as _dt
+    import json
+    import platform
+    import shutil
+    from pathlib import Path
+
+    import pandas as pd
+
+    from drives.format import read_drive, swap_into_place, temp_folder_beside
+    from inverse.linear_features import linear_model_for
+    from roadlib.iri import iri_segments
+    from roadlib.metrics import fit_iso_psd, profile_psd
+    from studies.runs import git_state, package_versions, write_json_atomic
+
+    t0 = _time.perf_counter()
+    started = _dt.datetime.now(_dt.timezone.utc)
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise EroadInputError(f"{out}: exists and is not a folder")
+    if out.exists() and any(out.iterdir()) and not force:
+        raise EroadInputError(f"{out}: exists and is not empty; choose another --out or use --force")
+    drive = read_drive(dataset)
+    names = response_channels(drive.channel_names)
+    if not names:
+        raise EroadInputError(f"{drive.path}: eroad replica needs response channels "
+                              f"(susp_disp_*, axle_acc_*, body_acc_*); present: "
+                              f"{', '.join(drive.channel_names) or 'none'}")
+    if not np.all(np.asarray(drive.speed) > 0.5):
+        raise EroadInputError(f"{drive.path}: eroad replica needs a moving vehicle (speed > 0.5 m/s throughout)")
+    lm, left_out = linear_model_for(drive.vehicle, "rigid", effects)
+    missing = [c for c in names if c not in lm.channel_names]
+    if missing:
+        raise EroadInputError(f"{drive.path}: channel(s) {', '.join(missing)} have no counterpart in "
+                              f"vehicle {lm.meta.get('vehicle')} (axles {len(lm.vp.axles)})")
+    noise = None
+    if noise_sd:
+        from inverse.cli import noise_psd_from_sd
+        psd = noise_psd_from_sd(noise_sd, names, drive.sample_rate_hz)
+        noise = {c: math.sqrt(p * 0.5 * drive.sample_rate_hz) for c, p in psd.items()}
+    chans = {c: drive.channels[c].to_numpy(float) for c in names}
+    rep = reconstruct(lm, drive.time, drive.speed, chans, noise=noise, progress=progress)
+    held, pred, rep2 = [], {}, None
+    if holdout is not None:
+        held = [c for c in names if axle_of(c) == int(holdout)]
+        keep = [c for c in names if axle_of(c) != int(holdout)]
+        if not held or not keep:
+            raise EroadInputError(f"--holdout {holdout}: the drive has no channels of axle {holdout}, or "
+                                  f"only those")
+        rep2 = reconstruct(lm, drive.time, drive.speed, {c: chans[c] for c in keep}, noise=noise,
+                           progress=progress)
+        pred = rep2.predict(held)
+    dx = float(rep.x[1] - rep.x[0])
+    cov = rep.covered
+    xc = rep.x[cov]
+    ident = cov & np.isfinite(rep.lambda_min)
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = temp_folder_beside(out)
+    (tmp / "figures").mkdir()
+    try:
+        pd.DataFrame({"x_m": rep.x, "z_left_m": rep.z_left, "z_right_m": rep.z_right,
+                      "identified": ident.astype(int), "lambda_min_m": rep.lambda_min,
+                      "lambda_max_m": rep.lambda_max}).to_csv(tmp / "tracks.csv", index=False,
+                                                              float_format="%.9g")
+        rows = []
+        iri = {}
+        for side, z in (("left", rep.z_left), ("right", rep.z_right)):
+            for L in (20.0, 100.0):
+                segs = iri_segments(xc, z[cov], L, start=float(xc[0]))
+                rows += [{"track": side, "segment_m": L, "start_m": s.start, "end_m": s.end,
+                          "iri_m_per_km": s.iri} for s in segs]
+                iri[f"{side}_{int(L)}m"] = [s.iri for s in segs]
+        pd.DataFrame(rows).to_csv(tmp / "iri.csv", index=False, float_format="%.6g")
+        est = profile_psd(rep.z_left[cov], dx)
+        est_r = profile_psd(rep.z_right[cov], dx)
+        pd.DataFrame({"n_cpm": est.n, "G_left_m3": est.G, "G_right_m3": est_r.G}).to_csv(
+            tmp / "psd.csv", index=False, float_format="%.6g")
+        lam_lo = float(np.nanmedian(rep.lambda_min[cov]))
+        lam_hi = float(np.nanmedian(rep.lambda_max[cov]))
+        fits = {}
+        for side, e in (("left", est), ("right", est_r)):
+            band = (max(1.0 / min(lam_hi, 50.0), e.n[1]), min(1.0 / lam_lo, 2.83))
+            try:
+                fits[side] = fit_iso_psd(e, band=band).to_dict()
+            except EroadInputError as exc:
+                fits[side] = {"error": str(exc)}
+        surf = replica_surface(rep)
+        surf.save(tmp / "road.npz")
+        surf.save(tmp / "road.crg")
+        figs = write_replica_figures(tmp / "figures", drive, rep, est, est_r, fits, held, pred, title=drive.name)
+        holdout_scores = {c: nrmse(pred[c], chans[c]) for c in held}
+        fit_scores = {c: nrmse(rep.fitted[c], chans[c]) for c in names}
+        summary = {
+            "format": RUN_FORMAT,
+            "dataset": {"name": drive.name, "path": str(Path(dataset).resolve()), "vehicle": str(drive.vehicle),
+                        "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz,
+                        "warnings": list(drive.warnings)},
+            "method": "time-domain MAP input estimation on the linear model (docs/replica.md)",
+            "grid": {"dx_m": dx, "x_start_m": float(rep.x[0]), "x_end_m": float(rep.x[-1]),
+                     "covered_m": [float(xc[0]), float(xc[-1])]},
+            "identified_band_m": {"median_lambda_min": lam_lo, "median_lambda_max": lam_hi,
+                                  "at_speed": dict(zip([f"{v:.2f}" for v in rep.info["speed_quantiles_mps"]],
+                                                       rep.info["band_at_speed_m"])),
+                                  "criterion": f"regularised resolution >= {RESOLUTION_MIN} on both tracks"},
+            "regularisation": {"alpha_per_m2": rep.alpha, "road_level_gd0_m3": rep.gd0,
+                               "choice": "empirical Bayes (EM): road level and channel model-error floors",
+                               "em": rep.info["em"]},
+            "channels": {"used": names, "sigma_used": rep.sigma, "sigma_sensor": rep.sigma_sensor,
+                         "fit_nrmse": fit_scores},
+            "holdout": {"axle": holdout, "channels": held, "nrmse": holdout_scores,
+                        "nrmse_definition": "RMS(pred - meas) / RMS(meas), means removed"},
+            "iri_m_per_km": iri,
+            "psd_iso_fit": fits,
+            "linear_model": {"effects_left_out": left_out, "notes": rep.info["linear_model_notes"]},
+            "figures": figs,
+            "files": ["tracks.csv", "iri.csv", "psd.csv", "road.npz", "road.crg"],
+            "timing": {"reconstruct_s": rep.info["wall_s"],
+                       "holdout_s": rep2.info["wall_s"] if rep2 is not None else 0.0,
+                       "cg_iterations": rep.info["cg_iterations"],
+                       "total_s": _time.perf_counter() - t0},
+        }
+        write_json_atomic(tmp / "summary.json", summary)
+        import tomli_w
+        cfg = {"dataset": str(Path(dataset).resolve()), "effects": json.dumps(effects or {}),
+               "noise_sd": dict(noise_sd or {}), "holdout": -1 if holdout is None else int(holdout),
+               "dx_m": dx, "substeps": rep.info["substeps"], "runin_s": rep.info["runin_s"]}
+        (tmp / "config.toml").write_text(tomli_w.dumps(cfg))
+        now = _dt.datetime.now(_dt.timezone.utc)
+        write_json_atomic(tmp / "run.json", {
+            "command": list(argv) if argv else ["run_replica"], "study": "replica",
+            "git": git_state(), "versions": package_versions(),
+            "host": {"hostname": platform.node(), "platform": platform.platform()},
+            "started": started.isoformat(), "finished": now.isoformat(),
+            "start_utc": started.strftime("%Y-%m-%dT%H:%M:%SZ"), "end_utc": now.strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "status": "complete", "wall_s": _time.perf_counter() - t0})
+        swap_into_place(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return summary
+
+
+def write_replica_figures(folder, drive, rep: Replica, est_l, est_r, fits, held, pred, title="") -> list:
+    """Time-domain comparison (measured vs the linear model on the replica, held-out
+    channels predicted from the replica made without them), PSD and track plots."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = np.asarray(drive.time, float)
+    shown = [c for c in ("susp_disp_3L", "axle_acc_3L", "body_acc_3R") if c in rep.fitted]
+    rows = [(c, rep.fitted[c], "fitted") for c in shown] + [(c, pred[c], "held out") for c in held[:3]]
+    fig, axes = plt.subplots(len(rows), 1, figsize=(10, 1.9 * len(rows) + 0.6), sharex=True)
+    axes = np.atleast_1d(axes)
+    t_mid = 0.5 * (t[0] + t[-1])
+    zoom = (t >= t_mid - 2.5) & (t <= t_mid + 2.5)
+    for ax, (c, p, kind) in zip(axes, rows):
+        m = drive.channels[c].to_numpy(float)
+        ax.plot(t[zoom], (m - m.mean())[zoom], "k", lw=1.0, label="measured")
+        ax.plot(t[zoom], (p - np.mean(p))[zoom], "C3" if kind == "held out" else "C0", lw=1.0,
+                label=f"linear model on replica ({kind}), nRMSE {nrmse(p, m):.2f}")
+        ax.set_ylabel(f"{c}\n[{drive.units.get(c, '')}]", fontsize=8)
+        ax.legend(loc="upper right", fontsize=7)
+    axes[-1].set_xlabel("time [s]")
+    fig.suptitle(f"Replica, time domain (5 s of the record) {title}\nblue: channels used in the reconstruction; "
+                 f"red: channels held out of it", fontsize=9)
+    fig.tight_layout()
+    files = []
+    p = folder / "replica_time.png"
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    files.append(p.name)
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for e, side, col in ((est_l, "left", "C0"), (est_r, "right", "C1")):
+        ax.loglog(e.n[1:], e.G[1:], col, label=f"replica {side}")
+        f = fits.get(side, {})
+        if "Gd_n0" in f:
+            n = np.geomspace(*f["band"], 50)
+            ax.loglog(n, f["Gd_n0"] * (n / 0.1) ** (-f["w"]), col + "--",
+                      label=f"ISO fit {side}: Gd(n0) {f['Gd_n0']:.3g} m^3, w {f['w']:.2f} (class {f['class']})")
+    lo = float(np.nanmedian(rep.lambda_min[rep.covered]))
+    hi = float(np.nanmedian(rep.lambda_max[rep.covered]))
+    ax.axvspan(1.0 / hi, 1.0 / lo, color="0.9", zorder=0, label=f"identified {lo:.2g}-{hi:.3g} m (median)")
+    ax.set_xlabel("spatial frequency n [cycles/m]")
+    ax.set_ylabel("PSD Gd(n) [m^3]")
+    ax.set_title(f"Replica track PSD {title}", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    p = folder / "replica_psd.png"
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    files.append(p.name)
+
+    fig, ax = plt.subplots(figsize=(10, 3.5))
+    cov = rep.covered
+    ax.plot(rep.x[cov], 1e3 * rep.z_left[cov], "C0", lw=0.8, label="left")
+    ax.plot(rep.x[cov], 1e3 * rep.z_right[cov], "C1", lw=0.8, label="right")
+    ax.set_xlabel("x [m] (0: first axle at the first sample)")
+    ax.set_ylabel("height [mm]")
+    ax.set_title(f"Replica tracks {title}", fontsize=9)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    p = folder / "replica_tracks.png"
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    files.append(p.name)
+    return files

@@ -1,0 +1,192 @@
+"""Blind benchmark of the road replica (issue 17) against synthetic truth.
+
+For each family and seed: ``eroad synth --scenario FAMILY --seed S`` (cached), the
+replica from the dataset's channels and speed only (``inverse.replica.reconstruct``
+on the nominal linear model; truth/ is read here, for scoring, never by the method),
+then:
+
+* correlation of reconstructed and true track in the 0.5-20 m band, per track, over
+  the stretch some tyre ran over during the record.  The true "track" of a side is
+  the mean of the road under that side's tyre lines (front singles at |y| = 1.02 m,
+  rear duals at 0.76 and 1.10 m): the vehicle's wheel track as the two-track model
+  defines it.  The correlation with the single line under the front tyres is
+  reported beside it (``corr_line``);
+* IRI per 100 m (roadlib.iri) of reconstruction and truth, relative error;
+* held out (``--holdout N`` drives): the replica from all channels but axle 2's,
+  whose six channels are then predicted by the linear model on that replica:
+  normalised RMSE = RMS(pred - meas) / RMS(meas).
+
+Usage::
+
+    nice python benchmarks/bench_replica.py --families null:10 second:5 random:3 \
+        --holdout 3 --out results/replica
+
+Writes ``cases.jsonl`` (one line per drive, appended as they finish), ``summary.json``
+and ``summary.md`` in --out.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from drives.format import read_drive  # noqa: E402
+from inverse.replica import (axle_of, band_correlation, nrmse, reconstruct,  # noqa: E402
+                             response_channels)
+
+BAND = (0.5, 20.0)
+
+
+def true_tracks(dataset, x, contacts) -> dict:
+    """Scoring only: the truth road under each side's tyre lines at replica positions x.
+
+    Returns {"L": mean over the side's tyre lines, "R": ..., "L_line": the first
+    contact's line, "R_line": ...} on ``x`` (0 = first axle at the first sample).
+    """
+    from drives.synth import plan_drive, read_truth
+    from roadlib.surface import RoadSurface
+
+    tr = read_truth(dataset)
+    cfg = tomllib.loads((Path(dataset) / "truth" / "scenario.toml").read_text())
+    axle_x = tr["vehicle"]["axle_x_m"]
+    plan = plan_drive(cfg, axle_x)
+    ref = int(cfg["scenario"]["reference_axle"])
+    x1 = plan["x_ref"][plan["n_runin"]] - axle_x[ref - 1]
+    road = RoadSurface.load(tr["road_file"])
+    ys = {}
+    for c in contacts:
+        ys.setdefault(c["side"], []).append(c["y"])
+    out = {}
+    for s, yy in ys.items():
+        out[s] = np.mean([road.track(y, x1 + x) for y in yy], axis=0)
+        out[s + "_line"] = road.track(yy[0], x1 + x)
+    return out
+
+
+def iri_100(x, z, start) -> list:
+    from roadlib.iri import iri_segments
+    return [s.iri for s in iri_segments(x, z, 100.0, start=start)]
+
+
+def run_case(family: str, seed: int, cache: Path, holdout: bool) -> dict:
+    from drives.synth import synth_command
+    from vehicles.linear import linear_model
+
+    ds = cache / f"{family}-{seed}"
+    if not (ds / "truth" / "summary.json").is_file():
+        synth_command(scenario=family, seed=seed, out=ds, force=True)
+    drive = read_drive(ds)
+    lm = linear_model(drive.vehicle)
+    names = response_channels(drive.channel_names)
+    chans = {c: drive.channels[c].to_numpy(float) for c in names}
+    t0 = time.perf_counter()
+    rep = reconstruct(lm, drive.time, drive.speed, chans)
+    wall = time.perf_counter() - t0
+    cov = rep.covered
+    x = rep.x[cov]
+    dx = float(rep.x[1] - rep.x[0])
+    truth = true_tracks(ds, rep.x, lm.contacts)
+    case = {"family": family, "seed": seed, "wall_s": wall, "cg_iterations": rep.info["cg_iterations"],
+            "gd0_em": rep.gd0, "covered_m": float(x[-1] - x[0]),
+            "band_at_speed_m": rep.info["band_at_speed_m"], "speed_quantiles_mps": rep.info["speed_quantiles_mps"]}
+    for s, est in (("L", rep.z_left), ("R", rep.z_right)):
+        zt = truth[s][cov]
+        ze = est[cov]
+        case[f"corr_{s}"] = band_correlation(ze, zt, dx, BAND)
+        case[f"corr_line_{s}"] = band_correlation(ze, truth[s + "_line"][cov], dx, BAND)
+        start = float(x[0])
+        ie, it = iri_100(x, ze, start), iri_100(x, zt, start)
+        il = iri_100(x, truth[s + "_line"][cov], start)
+        case[f"iri100_est_{s}"] = ie
+        case[f"iri100_true_{s}"] = it
+        case[f"iri100_line_{s}"] = il
+        case[f"iri100_relerr_{s}"] = [float(a / b - 1) for a, b in zip(ie, it)]
+    if holdout:
+        keep = [c for c in names if axle_of(c) != 2]
+        held = [c for c in names if axle_of(c) == 2]
+        rep2 = reconstruct(lm, drive.time, drive.speed, {c: chans[c] for c in keep})
+        pred = rep2.predict(held)
+        case["holdout_nrmse"] = {c: nrmse(pred[c], chans[c]) for c in held}
+        c2 = rep2.covered
+        case["holdout_corr_L"] = band_correlation(rep2.z_left[c2], truth["L"][c2], dx, BAND)
+        case["holdout_corr_R"] = band_correlation(rep2.z_right[c2], truth["R"][c2], dx, BAND)
+    return case
+
+
+def summarise(cases: list) -> dict:
+    out = {}
+    for fam in sorted({c["family"] for c in cases}):
+        cc = [c for c in cases if c["family"] == fam]
+        corr = np.array([[c["corr_L"], c["corr_R"]] for c in cc])
+        line = np.array([[c["corr_line_L"], c["corr_line_R"]] for c in cc])
+        err = np.concatenate([np.abs(c["iri100_relerr_L"] + c["iri100_relerr_R"]) for c in cc])
+        ho = [v for c in cc for v in c.get("holdout_nrmse", {}).values()]
+        out[fam] = {"drives": len(cc), "corr_min": float(corr.min()), "corr_median": float(np.median(corr)),
+                    "corr_line_min": float(line.min()), "corr_line_median": float(np.median(line)),
+                    "iri100_abs_relerr_max": float(err.max()) if err.size else None,
+                    "iri100_abs_relerr_median": float(np.median(err)) if err.size else None,
+                    "iri100_within_10pct": f"{int(np.sum(err <= 0.10))}/{err.size}",
+                    "holdout_channels": len(ho),
+                    "holdout_nrmse_max": float(max(ho)) if ho else None,
+                    "holdout_nrmse_median": float(np.median(ho)) if ho else None,
+                    "wall_s_median": float(np.median([c["wall_s"] for c in cc]))}
+    return out
+
+
+def write_md(summary: dict, path: Path, command: str) -> None:
+    lines = ["# Road replica benchmark (issue 17)", "", f"Command: `{command}`", "",
+             "| family | drives | corr 0.5-20 m min / median | corr (front tyre line) min / median | "
+             "IRI 100 m within 10 % | IRI rel. err. median / max | held-out nRMSE median / max (channels) | "
+             "wall s (median) |", "|---|---|---|---|---|---|---|---|"]
+    for fam, s in summary.items():
+        ho = (f"{s['holdout_nrmse_median']:.3f} / {s['holdout_nrmse_max']:.3f} ({s['holdout_channels']})"
+              if s["holdout_channels"] else "-")
+        lines.append(f"| {fam} | {s['drives']} | {s['corr_min']:.3f} / {s['corr_median']:.3f} | "
+                     f"{s['corr_line_min']:.3f} / {s['corr_line_median']:.3f} | {s['iri100_within_10pct']} | "
+                     f"{s['iri100_abs_relerr_median']:.3f} / {s['iri100_abs_relerr_max']:.3f} | {ho} | "
+                     f"{s['wall_s_median']:.0f} |")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--families", nargs="+", default=["null:10", "second:5", "random:3"],
+                    help="FAMILY:N (seeds 1..N)")
+    ap.add_argument("--holdout", type=int, default=3, help="drives per family with the axle-2 hold-out")
+    ap.add_argument("--cache", default="/tmp/eroad-replica-bench", help="where the synthetic drives go")
+    ap.add_argument("--out", default=str(ROOT / "results" / "replica"))
+    args = ap.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    cache = Path(args.cache)
+    cache.mkdir(parents=True, exist_ok=True)
+    command = "nice python benchmarks/bench_replica.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    cases = []
+    jl = out / "cases.jsonl"
+    jl.write_text("")
+    for item in args.families:
+        fam, _, n = item.partition(":")
+        for seed in range(1, int(n or 1) + 1):
+            case = run_case(fam, seed, cache, holdout=seed <= args.holdout)
+            cases.append(case)
+            with jl.open("a") as f:
+                f.write(json.dumps(case) + "\n")
+            print(f"{fam} {seed}: corr L {case['corr_L']:.3f} R {case['corr_R']:.3f}, IRI err "
+                  f"{[round(v, 3) for v in case['iri100_relerr_L'] + case['iri100_relerr_R']]}, "
+                  f"holdout {case.get('holdout_nrmse')}, {case['wall_s']:.0f} s", flush=True)
+            summary = summarise(cases)
+            (out / "summary.json").write_text(json.dumps({"command": command, "families": summary}, indent=1))
+            write_md(summary, out / "summary.md", command)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
