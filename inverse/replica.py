@@ -722,7 +722,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         lam_hi = float(np.nanmedian(rep.lambda_max[cov]))
         fits = {}
         for side, e in (("left", est), ("right", est_r)):
-            band = (max(1.0 / min(lam_hi, 50.0), e.n[1]), min(1.0 / lam_lo, 2.83))
+            band = (max(1.0 / min(lam_hi, 20.0), e.n[1]), min(1.0 / lam_lo, 2.83))
             try:
                 fits[side] = fit_iso_psd(e, band=band).to_dict()
             except EroadInputError as exc:
