@@ -342,69 +342,149 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
 
     kc = float(contact_stiffness)
     xs = x_start + speed * t
-    # static equilibrium in contact at x_start
+    # slack droppers: contact-wire / messenger DOFs, static tensions, stiffness
+    dc, dm = line.dropper_dofs()
+    slack_on = bool(line.params.dropper_slack) and dc.size > 0
+    if slack_on:
+        T0 = line.dropper_static_tension()
+        kd = float(line.params.dropper_stiffness)
+        s_open = T0 / kd  # compression (w_c - w_m) at which a dropper goes slack
+        d_idx = [np.array([i for i in (dc[j], dm[j]) if i >= 0]) for j in range(dc.size)]
+        d_w = [np.array([w for i, w in ((dc[j], 1.0), (dm[j], -1.0)) if i >= 0])
+               for j in range(dc.size)]
+
+    def slack_set(q) -> frozenset:
+        if not slack_on:
+            return frozenset()
+        comp = np.where(dc >= 0, q[np.maximum(dc, 0)], 0.0) - np.where(dm >= 0, q[np.maximum(dm, 0)], 0.0)
+        return frozenset(np.flatnonzero(comp > s_open).tolist())
+
+    def dropper_force(q, S) -> np.ndarray:
+        """Applied force of the slack droppers' correction: kd d d^T q - T0 d."""
+        f = np.zeros(N)
+        for j in S:
+            sj = float(d_w[j] @ q[d_idx[j]])
+            f[d_idx[j]] += (kd * sj - T0[j]) * d_w[j]
+        return f
+
+    # static equilibrium in contact at x_start (active set over contact and droppers)
     hi, hw = h_of(xs[0])
     y0 = float(line.profile(xs[0]))
     hvec = np.zeros(N); hvec[hi] = hw
-    Hs = sp.coo_matrix((np.outer(hw, hw).ravel(), (np.repeat(hi, hi.size), np.tile(hi, hi.size))),
-                       shape=(N, N))
-    Ks = (K + kc * Hs).tocsc()
-    q = spla.spsolve(Ks, f_ext(0) + kc * y0 * hvec)
-    p = float(hvec @ q - y0)
-    if p <= 0:
-        q = spla.spsolve(K.tocsc(), f_ext(0))  # static state without contact
+    S = frozenset()
+    on = True
+    for _ in range(30):
+        rows_, cols_, vals_ = [], [], []
+        rhs_s = f_ext(0).copy()
+        if on:
+            rows_.append(np.repeat(hi, hi.size)); cols_.append(np.tile(hi, hi.size))
+            vals_.append(kc * np.outer(hw, hw).ravel())
+            rhs_s += kc * y0 * hvec
+        for j in S:
+            ii, ww = d_idx[j], d_w[j]
+            rows_.append(np.repeat(ii, ii.size)); cols_.append(np.tile(ii, ii.size))
+            vals_.append(-kd * np.outer(ww, ww).ravel())
+            rhs_s[ii] -= T0[j] * ww
+        Ks = K
+        if rows_:
+            Ks = K + sp.coo_matrix((np.concatenate(vals_), (np.concatenate(rows_),
+                                                            np.concatenate(cols_))), shape=(N, N))
+        q = spla.spsolve(Ks.tocsc(), rhs_s)
         p = float(hvec @ q - y0)
-        if p > 0:
-            raise SimulationError("static contact state inconsistent at the start")
-    fc0 = kc * max(p, 0.0) * hvec
+        S_new, on_new = slack_set(q), p > 0
+        if S_new == S and on_new == on:
+            break
+        S, on = S_new, on_new
+    else:
+        raise SimulationError("static state (contact and slack droppers) did not converge")
+    fcon0 = kc * max(p, 0.0) if on else 0.0
+    fnl0 = -fcon0 * hvec + dropper_force(q, S)  # applied nonlinear forces
     v = np.zeros(N)
     a = np.zeros(N)
 
     st = _HHT(M, C, K, dt, alpha)
-    kp = (1.0 + alpha) * kc
+    al = st.a
+    kp = (1.0 + al) * kc
+    ydrop: dict[int, np.ndarray] = {}
+
+    def ydrop_of(j: int) -> np.ndarray:
+        y = ydrop.get(j)
+        if y is None:
+            dv = np.zeros(N); dv[d_idx[j]] = d_w[j]
+            y = ydrop[j] = st.lu.solve(dv)
+        return y
+
     rec = np.arange(0, n_steps + 1, max(1, int(record_every)))
     nr = rec.size
     force = np.zeros(nr); headz = np.zeros(nr); uplift = np.zeros(nr); wire = np.zeros(nr)
+    nslack = np.zeros(nr, dtype=np.int16)
     coll = np.zeros((nr, m))
     poles = line.wire_dofs("contact")[line.pole_nodes] if line.pole_nodes.size else np.zeros(0, int)
     pole_up = np.zeros((nr, poles.size))
 
-    def store(j, k, q, fcon):
+    def store(j, k, q, fcon, ns):
         idx, w = line.shape(xs[k])
         force[j] = fcon
         headz[j] = q[head]
         uplift[j] = w @ q[idx]
         wire[j] = uplift[j] + line.profile(xs[k])
         coll[j] = q[nl:]
+        nslack[j] = ns
         if poles.size:
             pole_up[j] = np.where(poles >= 0, q[np.maximum(poles, 0)], 0.0)
 
-    store(0, 0, q, kc * max(p, 0.0))
+    store(0, 0, q, fcon0, len(S))
     j = 1
     f0 = f_ext(0)
     every = max(1, n_steps // 20)
+    n_unconverged = 0
     for k in range(1, n_steps + 1):
         f1 = f_ext(k)
-        q0 = st.lu.solve(st.rhs(q, v, a, f1, f0, fc0))
+        r = st.rhs(q, v, a, f1, f0, np.zeros(N)) - al * fnl0
+        yb = st.lu.solve(r)
         hi, hw = h_of(xs[k])
         y0 = float(line.profile(xs[k]))
-        p0 = float(hw @ q0[hi]) - y0
-        if p0 > 0.0:
-            hvec = np.zeros(N); hvec[hi] = hw
-            y = st.lu.solve(hvec)
-            hy = float(hw @ y[hi])
-            s = (p0 + y0 + kp * hy * y0) / (1.0 + kp * hy)
-            q1 = q0 + y * (kp * (y0 - s))
-            fcon = kc * (s - y0)
-            fc1 = fcon * hvec
-        else:
-            q1 = q0
-            fcon = 0.0
-            fc1 = np.zeros(N)
+        hvec = np.zeros(N); hvec[hi] = hw
+        yh = None
+        # active set: contact on/off, slack droppers; start from the last step's set
+        p_free = float(hw @ yb[hi]) - y0
+        on_k = p_free > 0.0
+        S_k = S
+        for it in range(12):
+            cols = []  # (idx, w, D, c): column u, stiffness change, rhs coefficient
+            Ycols = []
+            if on_k:
+                if yh is None:
+                    yh = st.lu.solve(hvec)
+                cols.append((hi, hw, kp, kp * y0)); Ycols.append(yh)
+            for jd in sorted(S_k):
+                cols.append((d_idx[jd], d_w[jd], -(1.0 + al) * kd, -(1.0 + al) * T0[jd]))
+                Ycols.append(ydrop_of(jd))
+            if cols:
+                Y = np.column_stack(Ycols)
+                cvec = np.array([c[3] for c in cols])
+                y = yb + Y @ cvec
+                UtY = np.array([[cu[1] @ Y[cu[0], i] for i in range(len(cols))] for cu in cols])
+                Uty = np.array([cu[1] @ y[cu[0]] for cu in cols])
+                Dinv = np.diag([1.0 / c[2] for c in cols])
+                q1 = y - Y @ np.linalg.solve(Dinv + UtY, Uty)
+            else:
+                q1 = yb
+            p1 = float(hw @ q1[hi]) - y0
+            on_new, S_new = p1 > 0.0, slack_set(q1)
+            if on_new == on_k and S_new == S_k:
+                break
+            if it == 11:  # keep the set q1 was computed with
+                n_unconverged += 1
+                break
+            on_k, S_k = on_new, S_new
+        on, S = on_k, S_k
+        fcon = kc * p1 if on else 0.0
+        fnl1 = -fcon * hvec + dropper_force(q1, S)
         v, a = st.finish(q1, q, v, a)
-        q, f0, fc0 = q1, f1, fc1
+        q, f0, fnl0 = q1, f1, fnl1
         if j < nr and rec[j] == k:
-            store(j, k, q, fcon)
+            store(j, k, q, max(fcon, 0.0), len(S))
             j += 1
         if k % every == 0:
             if not np.isfinite(q[head]):
@@ -413,10 +493,11 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
                 progress(k / n_steps)
     tr = t[rec]
     ch = {"x": xs[rec], "force": force, "head_z": headz, "uplift": uplift, "wire_z": wire,
-          "base_z": zb[rec], "collector": coll, "pole_uplift": pole_up}
+          "base_z": zb[rec], "collector": coll, "pole_uplift": pole_up, "n_slack": nslack}
     units = {"time": "s", "x": "m", "force": "N", "head_z": "m", "uplift": "m", "wire_z": "m",
-             "base_z": "m", "collector": "m", "pole_uplift": "m"}
+             "base_z": "m", "collector": "m", "pole_uplift": "m", "n_slack": "-"}
     meta = {"dt": dt, "alpha": alpha, "contact_stiffness": kc, "speed": speed,
             "x_start": x_start, "x_end": x_end, "n_dof": N, "line": line.params.name,
-            "collector_labels": ",".join(collector.labels)}
+            "collector_labels": ",".join(collector.labels), "dropper_slack": slack_on,
+            "active_set_unconverged_steps": n_unconverged}
     return ContactResult(tr, ch, units, meta)

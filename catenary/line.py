@@ -23,8 +23,13 @@ messenger on its support (spring, or fixed).  Both wire ends of the model are an
 Displacements are measured from the static equilibrium under gravity: the model is
 linear, gravity only sets the static state, and the designed contact wire height
 profile (pre-sag) enters the contact as a known function :meth:`ContactLine.profile`.
-Droppers do not slacken (linear); this is the main simplification against the EN 50318
-/ benchmark models, which let droppers go slack under compression.
+Droppers can slacken (``dropper_slack = true``): a dropper carries its static tension
+``T0`` (:meth:`ContactLine.dropper_static_tension`, the contact wire's weight between
+neighbouring droppers less the share the tension carries through the pre-sag curvature)
+and cannot push, so it goes slack when the contact wire rises above the messenger by
+more than ``T0 / k_d``; the time integrator (:mod:`catenary.contact`) then removes its
+stiffness by a low-rank update.  With ``dropper_slack = false`` droppers are linear
+springs that also push.
 
 Coordinates: x along the line [m] from the first anchor, z up [m].
 
@@ -101,6 +106,11 @@ class LineParams:
     rayleigh_stiffness: float = _f("s", "Rayleigh stiffness coefficient b")
     element_length: float = _f("m", "largest finite-element length")
     source: str = _f("-", "where the numbers come from", default="")
+    dropper_slack: bool = _f("-", "droppers cannot push: slack when compressed beyond "
+                             "their static tension", default=False)
+    gravity: float = _f("m/s^2", "gravity for the dropper static tensions", default=9.81)
+    sources: tuple[tuple[str, str], ...] = _f("-", "field -> where the number comes from",
+                                              default=())
 
     @property
     def length(self) -> float:
@@ -207,6 +217,9 @@ def load_line(name_or_path: str | Path) -> LineParams:
     except tomllib.TOMLDecodeError as exc:
         raise EroadInputError(f"{p}: not valid TOML ({exc})") from None
     data = {k: v for k, v in data.items() if not k.startswith("source_")}
+    srcs = data.pop("sources", {})
+    if not isinstance(srcs, dict):
+        raise EroadInputError(f"{p}: [sources] must be a table")
     wires = {}
     for wname in ("contact", "messenger"):
         t = data.pop(wname, None)
@@ -224,6 +237,10 @@ def load_line(name_or_path: str | Path) -> LineParams:
     for k, v in kw.items():
         if k in ("name", "source"):
             out[k] = str(v)
+        elif k == "dropper_slack":
+            if not isinstance(v, bool):
+                raise EroadInputError(f"{p}: 'dropper_slack' must be true or false")
+            out[k] = v
         elif k in ("contact", "messenger"):
             out[k] = wires[k]
         elif k == "dropper_x":
@@ -236,6 +253,7 @@ def load_line(name_or_path: str | Path) -> LineParams:
             out[k] = v
         else:
             out[k] = _num(v, p, k)
+    out["sources"] = tuple((str(k), str(v)) for k, v in srcs.items())
     lp = LineParams(**out)
     lp.validate(str(p))
     return lp
@@ -429,6 +447,35 @@ class ContactLine:
         ok = idx >= 0
         out[ok] = q[idx[ok]]
         return out
+
+    def dropper_static_tension(self) -> np.ndarray:
+        """Static tension ``T0`` [N] of each dropper (order of ``dropper_nodes``).
+
+        Each dropper carries the contact wire's weight over its tributary length (half
+        the distance to the neighbouring droppers; a pole counts as a neighbour, the
+        steady arm carrying the part next to it) less what the wire tension carries
+        through the pre-sag curvature (``8 T presag / span^2`` per metre, the parabola's
+        ``T w''``), plus its contact wire clamp and half its own mass.  The exact values
+        follow from the dropper lengths of a form-finding, which this model does not do.
+        """
+        p = self.params
+        if p.messenger is None or not p.dropper_x:
+            return np.zeros(0)
+        xs = [0.0] + sorted(p.dropper_x) + [p.span]
+        trib = {xs[i]: 0.5 * (xs[i + 1] - xs[i - 1]) for i in range(1, len(xs) - 1)}
+        q = p.contact.mass_per_length * p.gravity - 8.0 * p.contact.tension * p.presag / p.span ** 2
+        t0 = np.array([q * trib[d] + p.gravity * (p.clamp_mass_contact + 0.5 * p.dropper_mass)
+                       for d in p.dropper_x])
+        return np.tile(t0, p.n_spans)
+
+    def dropper_dofs(self) -> tuple[np.ndarray, np.ndarray]:
+        """Free-DOF indices (contact wire, messenger) of every dropper's ends (-1 where
+        anchored), in the order of ``dropper_nodes``."""
+        if self.params.messenger is None:
+            return np.zeros(0, int), np.zeros(0, int)
+        c = self._full_to_free[2 * self.dropper_nodes]
+        m = self._full_to_free[self._messenger_offset + 2 * self.dropper_nodes]
+        return c, m
 
     def point_load(self, x: float, force: float) -> np.ndarray:
         """Free-DOF load vector of a vertical point force ``force`` [N] on the contact wire

@@ -156,8 +156,8 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
 
 
 def railway_reference(speeds_kmh=(250.0, 300.0), *, dt: float = 5e-4,
-                      line: str | Path = "benchmark2015",
-                      pantograph: str | Path = "en50318_3mass",
+                      line: str | Path = "en50318",
+                      pantograph: str | Path = "en50318",
                       analysis_spans: tuple[int, int] = (4, 6)) -> dict[str, Any]:
     """The railway reference case at the given speeds against :data:`REFERENCE_RANGES`.
 

@@ -93,14 +93,14 @@ def test_no_contact_when_head_starts_below(short_line, pant):
 
 
 def test_pantograph_files_load_with_sources():
-    assert {"truck", "en50318_3mass"} <= set(pantograph_ids())
+    assert {"truck", "en50318", "dsa380"} <= set(pantograph_ids())
     for name in pantograph_ids():
         pp = load_pantograph(name)
         documented = {k for k, _ in pp.sources}
         numeric = {f for f in pp.__dataclass_fields__ if f not in ("name", "sources")}
         assert numeric <= documented, f"{name}: fields without a source: {numeric - documented}"
         f = vertical_modes(pp)
-        assert f[0] < 0.1 and 3 < f[1] < 30  # free chain: near-rigid mode + frame/head modes
+        assert f[0] < 0.5 and 3 < f[1] < 30  # free chain: soft frame mode + head/frame modes
 
 
 def test_pantograph_file_errors(tmp_path):

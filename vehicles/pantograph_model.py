@@ -50,7 +50,8 @@ class PantographParams:
     name: str = _f("-", "label")
     head_mass: float = _f("kg", "m1, pan head (collector strips)")
     upper_mass: float = _f("kg", "m2, upper frame")
-    lower_mass: float = _f("kg", "m3, lower frame")
+    lower_mass: float = _f("kg", "m3, lower frame (0: two-mass model, the upper frame "
+                           "stands on the base through k2, c2)")
     head_stiffness: float = _f("N/m", "k1, head suspension (head - upper frame)")
     upper_stiffness: float = _f("N/m", "k2, upper frame - lower frame")
     lower_stiffness: float = _f("N/m", "k3, lower frame - base")
@@ -73,7 +74,11 @@ class PantographParams:
             v = getattr(self, f.name)
             if not (isinstance(v, float) and math.isfinite(v) and v >= 0):
                 raise EroadInputError(f"{where}: {f.name} must be a finite number >= 0, got {v!r}")
-        for name in ("head_mass", "upper_mass", "lower_mass", "lateral_mass",
+        if self.lower_mass == 0.0 and (self.lower_stiffness or self.lower_damping):
+            raise EroadInputError(f"{where}: a two-mass pantograph (lower_mass = 0) must have "
+                                  "lower_stiffness = lower_damping = 0 (the upper frame stands "
+                                  "on the base through k2, c2)")
+        for name in ("head_mass", "upper_mass", "lateral_mass",
                      "head_stiffness", "upper_stiffness", "lateral_stiffness",
                      "head_half_width"):
             if getattr(self, name) <= 0:
@@ -136,9 +141,14 @@ def load_pantograph(name_or_path: str | Path) -> PantographParams:
 
 
 def _matrices(pp: PantographParams):
-    m = np.diag([pp.head_mass, pp.upper_mass, pp.lower_mass])
     k1, k2, k3 = pp.head_stiffness, pp.upper_stiffness, pp.lower_stiffness
     c1, c2, c3 = pp.head_damping, pp.upper_damping, pp.lower_damping
+    if pp.lower_mass == 0.0:  # two-mass model (EN 50318:2002 reference structure)
+        m = np.diag([pp.head_mass, pp.upper_mass])
+        K = np.array([[k1, -k1], [-k1, k1 + k2]])
+        C = np.array([[c1, -c1], [-c1, c1 + c2]])
+        return m, C, K
+    m = np.diag([pp.head_mass, pp.upper_mass, pp.lower_mass])
     K = np.array([[k1, -k1, 0.0], [-k1, k1 + k2, -k2], [0.0, -k2, k2 + k3]])
     C = np.array([[c1, -c1, 0.0], [-c1, c1 + c2, -c2], [0.0, -c2, c2 + c3]])
     return m, C, K
@@ -148,7 +158,9 @@ def collector(pp: PantographParams, static_force: float | None = None) -> Collec
     """The vertical three-mass chain as a :class:`catenary.contact.Collector`.
 
     DOFs ``(head, upper, lower)``, z up [m]; the contact DOF is the head; the base drives
-    the lower frame through ``k3, c3``; the static force acts on the lower frame.
+    the lower frame through ``k3, c3``; the static force acts on the lower frame.  With
+    ``lower_mass = 0`` (two-mass model) the DOFs are ``(head, frame)``, the base drives
+    the frame through ``k2, c2`` and the static force acts on the frame.
 
     Parameters
     ----------
@@ -158,6 +170,10 @@ def collector(pp: PantographParams, static_force: float | None = None) -> Collec
     """
     M, C, K = _matrices(pp)
     F0 = pp.static_force if static_force is None else float(static_force)
+    if pp.lower_mass == 0.0:
+        return Collector(M=M, C=C, K=K, head=0, f_static=np.array([0.0, F0]),
+                         base_k=np.array([0.0, pp.upper_stiffness]),
+                         base_c=np.array([0.0, pp.upper_damping]), labels=("head", "frame"))
     return Collector(M=M, C=C, K=K, head=0, f_static=np.array([0.0, 0.0, F0]),
                      base_k=np.array([0.0, 0.0, pp.lower_stiffness]),
                      base_c=np.array([0.0, 0.0, pp.lower_damping]),
