@@ -120,3 +120,66 @@ def level_sensitivity(lm, segment: dict, speed: float, channels, band=None,
 def sensitivity_line(sens: dict) -> str:
     """One line for a report: ``lam=0.5 x0.93, lam=2 x1.05, ...``."""
     return ", ".join(f"{k} x{v['factor']:.2f}" for k, v in sens.items())
+
+
+def run_summary(vehicle, segments, time, speed, channels, *, effects=None, chassis="rigid") -> dict:
+    """The lateral-structure entry of an inversion's ``summary.json``.
+
+    Parameters
+    ----------
+    vehicle : str or Path
+        The vehicle the inversion used.
+    segments : list of dict
+        Fitted segments (``t_start``, ``t_end`` [s], ``Gq_n0``, ``w``, ``nmin``, ``nmax``).
+    time, speed : ndarray
+        Record time [s] and speed [m/s].
+    channels : sequence of str
+        Fitted channels.
+    effects, chassis
+        As the inversion's model.
+
+    Returns
+    -------
+    dict
+        ``assumed`` (the structure), ``segments`` (per segment: mean speed and
+        :func:`level_sensitivity`'s factors), ``factor_range`` (per alternative, the
+        smallest and largest factor over the segments), or ``error`` where the linear
+        model could not be built for this vehicle.
+    """
+    from vehicles.linear import linear_model
+
+    try:
+        lm = linear_model(vehicle, chassis, effects=effects or None)
+    except EroadInputError as exc:
+        return {"assumed": ASSUMED, "error": f"sensitivity not computed: {exc}"}
+    time = np.asarray(time, float)
+    speed = np.asarray(speed, float)
+    rows, rng = [], {}
+    for i, s in enumerate(segments):
+        m = (time >= s["t_start"]) & (time <= s["t_end"])
+        v = float(np.mean(speed[m])) if m.any() else float(np.mean(speed))
+        try:
+            sens = level_sensitivity(lm, s, v, channels)
+        except EroadInputError as exc:
+            return {"assumed": ASSUMED, "error": f"sensitivity not computed: {exc}"}
+        rows.append({"segment": i + 1, "speed_mps": v,
+                     "factor": {k: d["factor"] for k, d in sens.items()}})
+        for k, d in sens.items():
+            lo, hi = rng.get(k, (math.inf, -math.inf))
+            rng[k] = (min(lo, d["factor"]), max(hi, d["factor"]))
+    return {"assumed": ASSUMED, "segments": rows,
+            "factor_range": {k: [float(a), float(b)] for k, (a, b) in rng.items()},
+            "meaning": "the level Gd(n0) the fit would have returned under that lateral structure "
+                       "is 'factor' times the reported one (linear truck, waviness held)"}
+
+
+def note_line(entry: dict) -> str:
+    """The sentence under Table 1."""
+    if "error" in entry:
+        return f"Lateral road structure assumed: {entry['assumed']} ({entry['error']})."
+    parts = []
+    for k, (a, b) in entry["factor_range"].items():
+        parts.append(f"{k} x{a:.2f}" if abs(b - a) < 0.005 else f"{k} x{a:.2f}-{b:.2f}")
+    return (f"Lateral road structure assumed: {entry['assumed']}; not identified by the data. "
+            "Had it been otherwise, the fitted Gd(n0) would be (over the segments): "
+            + ", ".join(parts) + " (docs/inverse.md, section 13).")

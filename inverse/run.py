@@ -256,7 +256,12 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             "road": {"file": "road.npz", "crg": "road.crg", "seed": sel["seed"], "dx": SIM_DX,
                      "seg_lengths_m": [float(v) for v in sim.layout()["seg_lengths"]]},
         }
-        write_table(table1(segs), tmp / "tables" / "table1", note=table1_note(summary["fit_quality"]))
+        from inverse.lateral import note_line, run_summary
+
+        summary["lateral"] = run_summary(drive.vehicle, segs, time, speed, list(chans),
+                                         effects=effects, chassis=chassis)
+        write_table(table1(segs), tmp / "tables" / "table1",
+                    note=table1_note(summary["fit_quality"]) + "\n\n" + note_line(summary["lateral"]))
         write_table(table2(rows, sel["spread"]), tmp / "tables" / "table2", note=TABLE2_NOTE)
         import pandas as pd
         pd.DataFrame([{"label": c["label"], "seed": c["seed"], "mismatch": c["mismatch"],

@@ -47,6 +47,9 @@ def test_invert_writes_the_run_and_ignores_truth(short_drive):
     assert sum(seg["proportion"] for seg in s["segments"]) == pytest.approx(1.0)
     assert {"axle_acc_3L", "axle_acc_3R"} <= set(s["errors"])
     assert s["selection"]["n_candidates"] == 3 and len(s["history"]) >= 2
+    # the lateral structure is a stated assumption with its sensitivity (inverse/lateral.py)
+    assert len(s["lateral"]["segments"]) == 2 and "lam=2" in s["lateral"]["factor_range"]
+    assert "Lateral road structure assumed" in (run / "tables" / "table1.md").read_text()
     rj = json.loads((run / "run.json").read_text())
     assert rj["status"] == "complete"
     assert rj["start_utc"] and rj["end_utc"] and rj["host"]["hostname"] and rj["seed"] == 0

@@ -58,3 +58,19 @@ def test_bad_input_one_line(lm):
         lateral.level_sensitivity(lm, SEG, -1.0, axle(lm))
     assert math.isfinite(lateral.level_sensitivity(lm, SEG, 10.0, axle(lm) + ["nope"])
                          ["lam=2"]["factor"])
+
+
+def test_run_summary_and_note():
+    import numpy as np
+
+    t = np.arange(0, 20, 0.005)
+    v = np.where(t < 10, 8.0, 12.0)
+    segs = [dict(SEG, t_start=0.0, t_end=10.0), dict(SEG, t_start=10.0, t_end=20.0)]
+    e = lateral.run_summary("dump_truck_8x4", segs, t, v, ["axle_acc_3L", "axle_acc_3R"])
+    assert [r["speed_mps"] for r in e["segments"]] == pytest.approx([8.0, 12.0], abs=0.01)
+    lo, hi = e["factor_range"]["duals in one rut"]
+    assert lo <= hi < 1.0
+    line = lateral.note_line(e)
+    assert line.startswith("Lateral road structure assumed: isotropic") and "duals in one rut x" in line
+    bad = lateral.run_summary("dump_truck_8x4", segs, t, v, ["nope"])
+    assert "not computed" in bad["error"] and "not computed" in lateral.note_line(bad)
