@@ -414,6 +414,20 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
             y = ydrop[j] = st.lu.solve(dv)
         return y
 
+    yunit: dict[int, np.ndarray] = {}
+
+    def unit_of(i: int) -> np.ndarray:
+        """K_eff^-1 e_i, cached while the collector is over the element (a few steps)."""
+        y = yunit.get(i)
+        if y is None:
+            if len(yunit) > 16:
+                for key in list(yunit)[:8]:
+                    if key != head:
+                        del yunit[key]
+            e = np.zeros(N); e[i] = 1.0
+            y = yunit[i] = st.lu.solve(e)
+        return y
+
     rec = np.arange(0, n_steps + 1, max(1, int(record_every)))
     nr = rec.size
     force = np.zeros(nr); headz = np.zeros(nr); uplift = np.zeros(nr); wire = np.zeros(nr)
@@ -454,8 +468,10 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
             cols = []  # (idx, w, D, c): column u, stiffness change, rhs coefficient
             Ycols = []
             if on_k:
-                if yh is None:
-                    yh = st.lu.solve(hvec)
+                if yh is None:  # K_eff^-1 h from cached unit columns of the element's DOFs
+                    yh = np.zeros(N)
+                    for i_, w_ in zip(hi, hw):
+                        yh += w_ * unit_of(int(i_))
                 cols.append((hi, hw, kp, kp * y0)); Ycols.append(yh)
             for jd in sorted(S_k):
                 cols.append((d_idx[jd], d_w[jd], -(1.0 + al) * kd, -(1.0 + al) * T0[jd]))
