@@ -318,16 +318,23 @@ def plot_shrink_bands(summary: Mapping, path: str | os.PathLike) -> Path:
     a, b = np.where(both, a, np.nan), np.where(both, b, np.nan)
     fig = Figure(figsize=(8.0, 3.2), layout="constrained")
     ax = fig.add_subplot()
-    ax.plot(fc, b, "o-", color="0.3", ms=3, label="nominal model")
-    ax.plot(fc, a, "s-", color="C2", ms=3, label=f"with {H['effect']}")
     fl = np.array([np.nan if v is None else v for v in summary["nominal"]["per_band_noise_floor"]])
-    ax.plot(fc, fl, "--", color="0.6", lw=1, label="noise floor (expected for a correct model)")
+    # each curve through its estimated bands only: a band without an estimate is skipped,
+    # not a break that leaves a neighbouring band as a lone point
+    for y, style, kw in ((b, "o-", dict(color="0.3", ms=3, label="nominal model")),
+                         (a, "s-", dict(color="C2", ms=3, label=f"with {H['effect']}")),
+                         (fl, "--", dict(color="0.6", lw=1,
+                                         label="noise floor (expected for a correct model)"))):
+        ok = np.isfinite(y)
+        ax.plot(fc[ok], y[ok], style, **kw)
+    missing = [f"{f:.3g}" for f, ok in zip(fc, np.isfinite(a) & np.isfinite(b)) if not ok]
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("third-octave band centre [Hz]")
     ax.set_ylabel("held-out gap per band [-]")
     ax.set_title(f"how far: shrink {H['shrink_fraction']:.2f} +- {H['shrink_spread'] or 0:.2f} "
-                 f"(seeds); {H['effect']}", fontsize=9)
+                 f"(seeds); {H['effect']}"
+                 + (f" (no estimate at {', '.join(missing)} Hz)" if missing else ""), fontsize=9)
     ax.legend(fontsize=7)
     fig.savefig(path, dpi=130)
     return Path(path)
