@@ -34,7 +34,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "pantograph-contact", help="pantograph on the e-tractor under a contact line: "
         "contact force statistics",
         description="Drive the e-tractor over a road, feed the pantograph-base motion into "
-        "a three-mass pantograph in penalty contact with a finite-element contact line, "
+        "a lumped (two- or three-mass) pantograph in penalty contact with a finite-element "
+        "contact line, "
         "and report EN 50367-style contact force statistics (mean, sd, Fm +/- 3 sd, "
         "min, max, contact loss) and the lateral offset against the head width.")
     p.add_argument("--road", metavar="FILE", help="road file (.npz or .crg)")
