@@ -10,7 +10,7 @@ from eroad.cli import main
 #: (written out here rather than read from eroad.cli: build_parser skips a command
 #: module that fails to import with ModuleNotFoundError, so a lost package would
 #: silently drop its commands from the list)
-DOCUMENTED_COMMANDS = ("road", "simulate", "effects", "vehicle", "modes", "data", "synth", "invert", "runs",
+DOCUMENTED_COMMANDS = ("road", "simulate", "effects", "vehicle", "modes", "data", "synth", "invert", "replica", "runs",
                        "study", "pantograph-contact", "reproduce", "diagnose")
 
 
