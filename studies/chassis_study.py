@@ -590,13 +590,16 @@ def square_unit(unit: str) -> str:
     return u.replace("^2", "\u00b2")
 
 
-def readable_log_axis(ax, max_decades: float = 1.5) -> None:
-    """A log y axis spanning less than ``max_decades`` gets ticks at 1, 2, 5 x 10^k with
+def readable_log_axis(ax) -> None:
+    """A log y axis holding fewer than two powers of ten gets ticks at 1, 2, 5 x 10^k with
     plain labels (matplotlib's default leaves one labelled tick, or none, on such a range)."""
     from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
     lo, hi = ax.get_ylim()
-    if lo > 0 and np.log10(hi / lo) < max_decades:
+    if lo <= 0:
+        return
+    decades = np.arange(np.ceil(np.log10(lo) - 1e-9), np.floor(np.log10(hi) + 1e-9) + 1)
+    if decades.size < 2:
         ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
         ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         ax.yaxis.set_minor_formatter(NullFormatter())
