@@ -169,6 +169,12 @@ def main(argv=None) -> int:
     cache = Path(args.cache)
     cache.mkdir(parents=True, exist_ok=True)
     command = "nice python benchmarks/bench_replica.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    from eroad.archive import finish_run_info, run_info, write_run_json
+
+    record = run_info("replica_benchmark", run_id=out.name, command=command, seed=None,
+                      extra={"families": args.families, "holdout": args.holdout})
+    write_run_json(out, record)
+    t_start = time.perf_counter()
     cases = []
     jl = out / "cases.jsonl"
     jl.write_text("")
@@ -185,6 +191,7 @@ def main(argv=None) -> int:
             summary = summarise(cases)
             (out / "summary.json").write_text(json.dumps({"command": command, "families": summary}, indent=1))
             write_md(summary, out / "summary.md", command)
+    write_run_json(out, finish_run_info(record, "complete", wall_s=time.perf_counter() - t_start))
     return 0
 
 

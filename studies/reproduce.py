@@ -148,6 +148,22 @@ def _step_chassis(run: Path, quick: bool, workers: int, log) -> dict:
     return _jsonable(summary)
 
 
+def rebase_diagnosis(dst: Path, src: Path, dataset: Path) -> None:
+    """A diagnosis folder copied from ``src`` to ``dst``: its recorded dataset path
+    (summary.json ``meta.dataset``, the report's dataset line) made relative to ``dst``."""
+    old = os.path.relpath(Path(dataset).resolve(), Path(src).resolve())
+    new = os.path.relpath(Path(dataset).resolve(), Path(dst).resolve())
+    sf = dst / "summary.json"
+    if sf.is_file():
+        summ = json.loads(sf.read_text())
+        if (summ.get("meta") or {}).get("dataset") == old:
+            summ["meta"]["dataset"] = new
+            sf.write_text(json.dumps(summ, indent=2))
+    rf = dst / "report.md"
+    if rf.is_file():
+        rf.write_text(rf.read_text().replace(f"- dataset: `{old}`", f"- dataset: `{new}`", 1))
+
+
 def _step_diagnose(run: Path, quick: bool, workers: int, log) -> dict:
     """The diagnosis the invert step already ran (its first stage), copied to diagnose/;
     run afresh only when the invert step was not run."""
@@ -155,8 +171,10 @@ def _step_diagnose(run: Path, quick: bool, workers: int, log) -> dict:
 
     made = run / "invert" / "diagnose"
     if (made / "summary.json").is_file():
-        shutil.copytree(made, run / "diagnose")
-        return _jsonable(json.loads((made / "summary.json").read_text()))
+        dst = run / "diagnose"
+        shutil.copytree(made, dst)
+        rebase_diagnosis(dst, made, run / "dataset")
+        return _jsonable(json.loads((dst / "summary.json").read_text()))
     return _jsonable(diagnose_dataset(run / "dataset", run / "diagnose", quick=quick,
                                       workers=workers))
 

@@ -198,3 +198,27 @@ def test_figures_4_5_show_the_window_in_its_record(partial_run):
     rec = read_drive(partial_run / "dataset" / "record")
     assert (win.time[0], win.duration_s) == (460.0, 30.0)
     assert rec.duration_s >= 120.0 and rec.time[0] < 460.0 and rec.time[-1] >= 490.0
+
+
+def test_copied_diagnosis_records_the_dataset_relative_to_its_new_folder(tmp_path):
+    """reproduce copies invert/diagnose to diagnose/: the dataset path it records must
+    point at RUN/dataset from the new folder (it was one level off)."""
+    import json
+
+    from studies.reproduce import rebase_diagnosis
+
+    run = tmp_path / "run"
+    src = run / "invert" / "diagnose"
+    src.mkdir(parents=True)
+    (run / "dataset").mkdir()
+    (src / "summary.json").write_text(json.dumps({"meta": {"dataset": "../../dataset"}}))
+    (src / "report.md").write_text("# x\n- dataset: `../../dataset`\n")
+    import shutil
+
+    dst = run / "diagnose"
+    shutil.copytree(src, dst)
+    rebase_diagnosis(dst, src, run / "dataset")
+    assert json.loads((dst / "summary.json").read_text())["meta"]["dataset"] == "../dataset"
+    assert "- dataset: `../dataset`" in (dst / "report.md").read_text()
+    assert (dst / json.loads((dst / "summary.json").read_text())["meta"]["dataset"]).resolve() \
+        == (run / "dataset").resolve()
