@@ -169,7 +169,10 @@ def test_road_psd_interval_of_neighbouring_tracks_and_the_centre_track(tmp_path,
     plot = json.loads(capsys.readouterr().out)
     naive = one["Gd_n0_rel_se"] / np.sqrt(41)
     assert naive * 2 < allt["Gd_n0_rel_se"] < one["Gd_n0_rel_se"]
-    assert 1.0 <= allt["effective_tracks"]["Gd_n0"] < 10.0
+    # 41 tracks 0.1 m apart on a class C road are worth about 3 independent ones for Gd(n0)
+    # (3.06 here; over 16 seeds the interval this gives is within 25 % of the seed spread):
+    # 2-5 fails both "all independent" (41) and "all one track" (1)
+    assert 2.0 <= allt["effective_tracks"]["Gd_n0"] <= 5.0
     assert allt["centre_track"]["Gd_n0"] == pytest.approx(plot["Gd_n0"], rel=1e-12)
     assert allt["centre_track"]["Gd_n0"] == pytest.approx(one["Gd_n0"], rel=1e-12)
 
