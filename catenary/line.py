@@ -39,7 +39,6 @@ wire motion, or the time integration (:mod:`catenary.contact`).
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import MISSING, dataclass, field, fields
 from pathlib import Path
 from typing import Any
@@ -204,18 +203,9 @@ def load_line(name_or_path: str | Path) -> LineParams:
     EroadInputError
         Missing file, unknown or missing key, non-numeric or impossible value.
     """
-    p = Path(name_or_path)
-    if not p.suffix:
-        p = DATA_DIR / f"line_{name_or_path}.toml"
-        if not p.is_file():
-            raise EroadInputError(f"unknown contact line '{name_or_path}' (built-in: "
-                                  f"{', '.join(line_ids())})")
-    if not p.is_file():
-        raise EroadInputError(f"contact line file not found: {p}")
-    try:
-        data = tomllib.loads(p.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise EroadInputError(f"{p}: not valid TOML ({exc})") from None
+    from eroad.tomlfile import read_builtin_or_file
+
+    p, data = read_builtin_or_file(name_or_path, DATA_DIR, "line_", "contact line", line_ids)
     data = {k: v for k, v in data.items() if not k.startswith("source_")}
     srcs = data.pop("sources", {})
     if not isinstance(srcs, dict):

@@ -13,19 +13,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
+
+from eroad.argtypes import positive_float
 
 __all__ = ["register"]
 
 
-def _positive(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not (math.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
-    return v
+_positive = positive_float
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

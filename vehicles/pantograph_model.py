@@ -23,7 +23,6 @@ contact line (:mod:`catenary`).
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
@@ -101,18 +100,9 @@ def load_pantograph(name_or_path: str | Path) -> PantographParams:
     EroadInputError
         Unknown id, missing file, bad TOML, unknown/missing key, bad value.
     """
-    p = Path(name_or_path)
-    if not p.suffix:
-        p = DATA_DIR / f"pantograph_{name_or_path}.toml"
-        if not p.is_file():
-            raise EroadInputError(f"unknown pantograph '{name_or_path}' (built-in: "
-                                  f"{', '.join(pantograph_ids())})")
-    if not p.is_file():
-        raise EroadInputError(f"pantograph file not found: {p}")
-    try:
-        data = tomllib.loads(p.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise EroadInputError(f"{p}: not valid TOML ({exc})") from None
+    from eroad.tomlfile import read_builtin_or_file
+
+    p, data = read_builtin_or_file(name_or_path, DATA_DIR, "pantograph_", "pantograph", pantograph_ids)
     names = [f.name for f in fields(PantographParams)]
     for key in data:
         if key not in names:
