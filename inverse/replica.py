@@ -641,9 +641,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         Axle whose channels are left out of a second reconstruction and predicted
         from it (validation); None: none.
     """
-    import datetime as _dt
     import json
-    import platform
     import shutil
     from pathlib import Path
 
@@ -653,11 +651,11 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
     from inverse.linear_features import linear_model_for
     from roadlib.iri import iri_segments
     from roadlib.metrics import fit_iso_psd, profile_psd
-    from studies.runs import git_state, package_versions, write_json_atomic
+    from eroad.archive import finish_run_info, run_info, write_json_atomic, write_run_json
 
     t0 = _time.perf_counter()
-    started = _dt.datetime.now(_dt.timezone.utc)
     out = Path(out)
+    record = run_info("replica", run_id=out.name, command=list(argv) if argv else ["run_replica"])
     if out.exists() and not out.is_dir():
         raise EroadInputError(f"{out}: exists and is not a folder")
     if out.exists() and any(out.iterdir()) and not force:
@@ -768,14 +766,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
                "noise_sd": dict(noise_sd or {}), "holdout": -1 if holdout is None else int(holdout),
                "dx_m": dx, "substeps": rep.info["substeps"], "runin_s": rep.info["runin_s"]}
         (tmp / "config.toml").write_text(tomli_w.dumps(cfg))
-        now = _dt.datetime.now(_dt.timezone.utc)
-        write_json_atomic(tmp / "run.json", {
-            "command": list(argv) if argv else ["run_replica"], "study": "replica",
-            "git": git_state(), "versions": package_versions(),
-            "host": {"hostname": platform.node(), "platform": platform.platform()},
-            "started": started.isoformat(), "finished": now.isoformat(),
-            "start_utc": started.strftime("%Y-%m-%dT%H:%M:%SZ"), "end_utc": now.strftime("%Y-%m-%dT%H:%M:%SZ"),
-            "status": "complete", "wall_s": _time.perf_counter() - t0})
+        write_run_json(tmp, finish_run_info(record, "complete", wall_s=_time.perf_counter() - t0))
         swap_into_place(tmp, out)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -805,8 +796,9 @@ def write_replica_figures(folder, drive, rep: Replica, est_l, est_r, fits, held,
         ax.set_ylabel(f"{c}\n[{drive.units.get(c, '')}]", fontsize=8)
         ax.legend(loc="upper right", fontsize=7)
     axes[-1].set_xlabel("time [s]")
-    fig.suptitle(f"Replica, time domain (5 s of the record) {title}\nblue: channels used in the reconstruction; "
-                 f"red: channels held out of it", fontsize=9)
+    legend = "blue: channels used in the reconstruction" + (
+        "; red: channels held out of it, predicted" if held else " (none held out)")
+    fig.suptitle(f"Replica, time domain (5 s of the record) {title}\n{legend}", fontsize=9)
     fig.tight_layout()
     files = []
     p = folder / "replica_time.png"
