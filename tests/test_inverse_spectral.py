@@ -34,7 +34,7 @@ def test_bounds_nyquist_cap_and_projection():
     assert b.nmax[1] == pytest.approx(200.0 / (2 * 11.28))
     th = b.clip_theta(params_to_theta([[1.0, 5.0, 0.19, 1.0]]))
     p = theta_to_params(th)[0]
-    assert p[0] <= b.Gq_n0[1] * (1 + 1e-12) and p[1] == 3.0
+    assert p[0] <= b.Gq_n0[1] * (1 + 1e-12) and p[1] == b.w[1] == 3.5
     assert p[3] / p[2] >= b.min_ratio * (1 - 1e-12)
 
 
