@@ -14,6 +14,19 @@ selection does not change the parameters), then scoring with
 * boundary error [s]: each interior true boundary to the nearest fitted one;
 * rows for all segments, segments >= 3 s and >= 8 s; median and worst.
 
+Second truth family (``--scenario second``, docs/second_family.md): the drives come from
+the independently written truck (drives/independent_truck.py), not from the nominal
+model's builder.  With ``--measured-every 4`` every 4th seed (S - first seed = 0, 4, 8, ...)
+drives the measured road profile instead (scenario ``second_measured``, as
+diagnosis/blind.py MEASURED_EVERY does); ``--scenario second_measured`` runs only those.
+A measured road has no true ISO parameters: ``read_truth`` gives one segment described by
+a least-squares line through the log Welch PSD of the whole 544 m profile (0.05-2
+cycles/m).  Here the truth of a measured drive is instead the profile the reference
+axle actually drove over, :func:`measured_truth`: the Whittle ISO fit of its two wheel
+tracks over the driven window and the same band (as :func:`oracle_fits` does for a
+synthetic road), and, model-free, the profile's own periodogram at 1 cycle/m and at
+each fitted segment's n_best (:func:`profile_scores`).
+
 Run:  nice python benchmarks/bench_inverse.py --cases 20 [--workers 2] [--root DIR]
 Per-case results are appended to ROOT/results.jsonl as they come (a rerun skips
 cases already there); the table is printed at the end.  No pass/fail.
@@ -58,6 +71,133 @@ def oracle_fits(dataset: Path, truth: dict, track_y=(-0.9, 0.9)) -> list:
     return out
 
 
+#: lateral positions [m] of the reference axle's wheel tracks (axle 3 of dump_truck_8x4:
+#: track 1.86 m, vehicles/params/dump_truck_8x4.toml); the measured-road profile is read there
+REF_TRACK_Y = (-0.93, 0.93)
+#: half-width of the band over which the profile's periodogram is averaged around a
+#: frequency n: [n / B, n B] with B = 2^(1/6), one third of an octave.  For a power law of
+#: waviness 2-3.5 the band mean differs from the value at n by < 1.6 % (band_mean_bias).
+THIRD_OCTAVE = 2.0 ** (1.0 / 6.0)
+
+
+def band_mean_bias(w: float, b: float = THIRD_OCTAVE) -> float:
+    """Mean of (n/n_c)^-w over [n_c / b, n_c b] (linear frequency), relative to its value at n_c."""
+    if abs(w - 1.0) < 1e-12:
+        return math.log(b * b) / (b - 1.0 / b)
+    return (b ** (1.0 - w) - b ** (w - 1.0)) / ((1.0 - w) * (b - 1.0 / b))
+
+
+def reference_axle_x(truth: dict, t) -> np.ndarray:
+    """Road x [m] of the reference axle at record times ``t`` [s].
+
+    Rebuilt from ``truth.json`` exactly as drives.synth.plan_drive lays the drive out:
+    PCHIP speed through the speed knots, sampled at the output rate from the run-in's
+    start, integrated by the trapezoid rule, plus axle 1's start position and the
+    reference axle's offset.
+    """
+    from scipy.interpolate import PchipInterpolator
+
+    rec, sp = truth["record"], truth["speed"]
+    fs, runin, T = float(rec["sample_rate_hz"]), float(rec["runin_s"]), float(rec["duration_s"])
+    k = np.arange(-int(round(runin * fs)), int(round(T * fs)) + 1)
+    t_rec = k / fs
+    v = PchipInterpolator(np.asarray(sp["t_s"], float), np.asarray(sp["v_mps"], float))(t_rec)
+    s = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t_rec))])
+    ax = truth["vehicle"]["axle_x_m"][int(rec["reference_axle"]) - 1]
+    x = float(truth["road"]["x_axle1_at_sim_start_m"]) + ax + s
+    return np.interp(np.asarray(t, float), t_rec, x)
+
+
+def window_psd(road, x0: float, x1: float, track_y=REF_TRACK_Y):
+    """One full-length Hann periodogram per wheel track over road x in [x0, x1], averaged."""
+    from roadlib.metrics import profile_psd
+
+    x = np.arange(x0, x1, road.dx)
+    if x.size < 64:
+        return None
+    return profile_psd(road.tracks(list(track_y), x).T, road.dx, nperseg=x.size)
+
+
+def band_mean(est, n: float, b: float = THIRD_OCTAVE) -> tuple[float, int]:
+    """Mean periodogram over [n / b, n b] and the number of bins in it (per track)."""
+    sel = (est.n >= n / b) & (est.n <= n * b)
+    if not np.any(sel):
+        return float("nan"), 0
+    return float(np.mean(est.G[sel])), int(sel.sum())
+
+
+def measured_truth(dataset: Path, truth: dict, track_y=REF_TRACK_Y) -> dict:
+    """The truth of a measured-road drive: the profile actually driven, ISO-fitted.
+
+    ``read_truth`` describes the measured profile as a whole (all 544 m, left edge,
+    least-squares line through log Welch PSD).  The segment the reference axle drove
+    (record time 0 to the end) is re-described here by the Whittle ISO fit
+    (:func:`roadlib.metrics.fit_iso_psd`) of the two wheel tracks' periodograms over the
+    driven window, in the truth's band [nmin, nmax]: the same rule :func:`oracle_fits`
+    applies to a synthetic segment, so for this drive the inversion is scored against
+    its oracle.  The whole-profile description is kept as ``Gq_n0_profile_file``,
+    ``w_profile_file``.
+    """
+    from roadlib.metrics import fit_iso_psd
+    from roadlib.surface import RoadSurface
+
+    road = RoadSurface.load(Path(dataset) / "truth" / "road.npz")
+    out = dict(truth)
+    segs = []
+    for s in truth["segments"]:
+        x0, x1 = reference_axle_x(truth, [s["t_start"], s["t_end"]])
+        est = window_psd(road, x0, x1, track_y)
+        fit = fit_iso_psd(est, band=(s["nmin"], s["nmax"]))
+        segs.append(dict(s, Gq_n0=float(fit.Gd_n0), w=float(fit.w), x_start=float(x0), x_end=float(x1),
+                         Gq_n0_profile_file=s["Gq_n0"], w_profile_file=s["w"],
+                         truth_rule="Whittle ISO fit of the driven window's wheel tracks"))
+    out["segments"] = segs
+    return out
+
+
+def profile_scores(dataset: Path, truth: dict, summary: dict, track_y=REF_TRACK_Y) -> list:
+    """Each FITTED segment against the measured profile under it, model-free.
+
+    For fitted segment [t_start, t_end]: the reference axle's road window, the wheel
+    tracks' periodogram there (:func:`window_psd`), its third-octave mean at 1 cycle/m
+    and at the segment's n_best (:func:`band_mean`), and the ISO fit of the window over
+    the truth's band.  Errors are ln(fit / profile); the fit's PSD at 1 cycle/m is
+    Gq_n0 (1 / 0.1)^-w.
+    """
+    from roadlib.metrics import fit_iso_psd
+    from roadlib.surface import RoadSurface
+
+    road = RoadSurface.load(Path(dataset) / "truth" / "road.npz")
+    band = (truth["segments"][0]["nmin"], truth["segments"][0]["nmax"])
+    rows = []
+    for f in summary["segments"]:
+        x0, x1 = reference_axle_x(truth, [f["t_start"], f["t_end"]])
+        est = window_psd(road, x0, x1, track_y)
+        r = {"t_start": f["t_start"], "t_end": f["t_end"], "duration_s": f["t_end"] - f["t_start"],
+             "x_start": float(x0), "x_end": float(x1), "Gq_fit": f["Gq_n0"], "w_fit": f["w"],
+             "objective": f.get("objective"), "n_features": f.get("n_features"),
+             "fit_quality": f.get("fit_quality"), "sd_laplace": f.get("sd_laplace"),
+             "sd_ln_Gq_n0": f.get("sd_ln_Gq_n0"), "sd_w": f["sd"]["w"]}
+        if est is None:
+            rows.append(r)
+            continue
+        try:
+            iso = fit_iso_psd(est, band=band)
+            r.update(Gq_prof=float(iso.Gd_n0), w_prof=float(iso.w))
+        except Exception as exc:   # too few bins in the band on a very short window
+            r["iso_fit_error"] = str(exc)
+        g1, n1 = band_mean(est, 1.0)
+        g1_fit = f["Gq_n0"] * (1.0 / 0.1) ** -f["w"]
+        r.update(G1_prof=g1, G1_fit=g1_fit, G1_bins=n1, lnG_1cpm_err=math.log(g1_fit / g1))
+        if "n_best" in f:
+            gb, nb = band_mean(est, f["n_best"])
+            r.update(n_best=f["n_best"], G_n_best_prof=gb, G_n_best_fit=f["G_n_best"], G_n_best_bins=nb,
+                     lnG_n_best_err=math.log(f["G_n_best"] / gb), sd_ln_G_n_best=f["sd_ln_G_n_best"],
+                     sd_ln_G_n_best_laplace=f.get("sd_ln_G_n_best_laplace"))
+        rows.append(r)
+    return rows
+
+
 def score_case(truth: dict, summary: dict) -> dict:
     """Per-segment errors of one inversion against its truth."""
     from inverse.pipeline import segment_errors
@@ -77,6 +217,7 @@ def score_case(truth: dict, summary: dict) -> dict:
                      "class_fit": class_of(f["Gq_n0"]),
                      # the PSD at 1 cycle/m (~10 Hz at 10 m/s, where the truck responds)
                      "dlnG_1cpm": abs(math.log(f["Gq_n0"] / s["Gq_n0"]) - (f["w"] - s["w"]) * math.log(10.0)),
+                     "lnG_1cpm_err": math.log(f["Gq_n0"] / s["Gq_n0"]) - (f["w"] - s["w"]) * math.log(10.0),
                      # signed errors and what the fit reported, for the interval calibration
                      "lnGq_err": math.log(f["Gq_n0"] / s["Gq_n0"]), "w_err": f["w"] - s["w"],
                      "sd_ln_Gq_n0": f["sd"]["ln_Gq_n0"], "sd_w": f["sd"]["w"],
@@ -156,14 +297,23 @@ def main(argv=None) -> int:
     ap.add_argument("--known-noise", action="store_true",
                     help="give the inversion the sensor-noise levels (a data-sheet value a user "
                          "would know; read from truth/ noise, nothing else of the truth)")
-    ap.add_argument("--scenario", default="random", choices=["random", "null"],
+    ap.add_argument("--scenario", default="random", choices=["random", "null", "second", "second_measured"],
                     help="random: the truth has leaf friction and a flexible frame the nominal "
                          "model lacks; null: the truth vehicle IS the nominal model (the method's "
-                         "accuracy alone, with the finer step, finer road grid and sensor noise)")
+                         "accuracy alone, with the finer step, finer road grid and sensor noise); "
+                         "second: the independently written truck (docs/second_family.md) on a "
+                         "synthetic ISO road; second_measured: the same truck on the measured profile")
+    ap.add_argument("--measured-every", type=int, default=0, metavar="K",
+                    help="with --scenario second: seeds S with (S - first seed) %% K == 0 drive the "
+                         "measured profile (scenario second_measured); diagnosis/blind.py uses K = 4")
     ap.add_argument("--no-default-effects", action="store_true",
                     help="truth vehicle without the scenario's leaf friction (no model gap but the "
                          "flexible frame and the finer step): the method's accuracy alone")
     a = ap.parse_args(argv)
+    if a.measured_every and a.scenario != "second":
+        ap.error("--measured-every needs --scenario second")
+    if a.measured_every < 0:
+        ap.error("--measured-every must be >= 0")
     from drives.synth import copy_without_truth, read_truth, synth_command
     from eroad.errors import EroadInputError
     from inverse.cli import run_inversion
@@ -184,20 +334,23 @@ def main(argv=None) -> int:
         if seed in done:
             seed += 1
             continue
-        ds = data_root / f"{a.scenario}-{seed}"
+        scen = a.scenario
+        if a.measured_every and (seed - a.first_seed) % a.measured_every == 0:
+            scen = "second_measured"
+        ds = data_root / f"{scen}-{seed}"
         try:
             if not (ds / "truth" / "summary.json").is_file():
-                synth_command(scenario=a.scenario, seed=seed, out=ds, force=True,
+                synth_command(scenario=scen, seed=seed, out=ds, force=True,
                               default_effects=not a.no_default_effects)
         except EroadInputError as exc:   # e.g. a class E road overloads a sensor range
-            case = {"seed": seed, "skipped": str(exc)}
+            case = {"seed": seed, "scenario": scen, "skipped": str(exc)}
             with res_file.open("a") as f:
                 f.write(json.dumps(case) + "\n")
             done[seed] = case
             print(f"seed {seed}: skipped ({exc})", flush=True)
             seed += 1
             continue
-        blind = data_root / f"blind-{a.scenario}-{seed}"
+        blind = data_root / f"blind-{scen}-{seed}"
         if not blind.exists():
             copy_without_truth(ds, blind)
         noise = None
@@ -209,11 +362,21 @@ def main(argv=None) -> int:
         summ = run_inversion(blind, root / f"run-{seed}", workers=a.workers, seed=0, candidates=0,
                              max_iter=a.max_iter, channels=a.channels, force=True,
                              polish=not a.no_polish, noise_sd=noise)
+        wall = time.perf_counter() - t0
         truth = read_truth(ds)
-        case = score_case(truth, summ)
-        for r, o in zip(case["segments"], oracle_fits(ds, truth)):
-            r["oracle"] = o
-        case.update(seed=seed, wall_s=time.perf_counter() - t0)
+        if scen == "second_measured":   # no true ISO segment: the driven profile, fitted (measured_truth)
+            mtruth = measured_truth(ds, truth)
+            case = score_case(mtruth, summ)
+            for r, s0, s1 in zip(case["segments"], truth["segments"], mtruth["segments"]):
+                r.update(oracle=None, Gq_profile_file=s0["Gq_n0"], w_profile_file=s0["w"],
+                         x_start=s1["x_start"], x_end=s1["x_end"])
+            case["profile"] = profile_scores(ds, truth, summ)
+        else:
+            case = score_case(truth, summ)
+            for r, o in zip(case["segments"], oracle_fits(ds, truth)):
+                r["oracle"] = o
+        case.update(seed=seed, scenario=scen, wall_s=wall,
+                    fit_model=summ.get("fit", {}).get("model"))
         with res_file.open("a") as f:
             f.write(json.dumps(case) + "\n")
         done[seed] = case
@@ -225,8 +388,59 @@ def main(argv=None) -> int:
     skipped = [d["seed"] for d in done.values() if "skipped" in d]
     if skipped:
         print(f"skipped seeds (dataset refused by the format's plausibility checks): {sorted(skipped)}")
-    print(table(cases))
+    print(report(cases))
     return 0
+
+
+def profile_table(cases: list, min_s: float = 3.0) -> str:
+    """Measured-road drives: every fitted segment >= ``min_s`` against the profile under it."""
+    from roadlib.psd import class_of
+
+    rs = [r for c in cases for r in c.get("profile", []) if r["duration_s"] >= min_s and "lnG_1cpm_err" in r]
+    if not rs:
+        return ""
+    g1 = np.abs([r["lnG_1cpm_err"] for r in rs])
+    lines = [f"Measured road, each fitted segment >= {min_s:g} s against the profile under it "
+             f"({len(rs)} segments of {len(cases)} drives; third-octave periodogram means, ISO fit "
+             f"over the truth's band):",
+             f"* G(1 cycle/m): median abs ln error {np.median(g1):.3f}, signed median "
+             f"{np.median([r['lnG_1cpm_err'] for r in rs]):+.3f}, within 20% in "
+             f"{100 * np.mean(g1 <= math.log(1.2)):.0f}%"]
+    gb = [r for r in rs if "lnG_n_best_err" in r]
+    if gb:
+        e = np.array([r["lnG_n_best_err"] for r in gb])
+        sd = np.array([r["sd_ln_G_n_best"] for r in gb])
+        lines.append(f"* G(n_best): median abs ln error {np.median(np.abs(e)):.3f}, signed median "
+                     f"{np.median(e):+.3f}, within 20% in {100 * np.mean(np.abs(e) <= math.log(1.2)):.0f}%, "
+                     f"inside the reported 90 % interval in {100 * np.mean(np.abs(e) <= 1.6448536 * sd):.0f}%")
+    iso = [r for r in rs if "Gq_prof" in r]
+    if iso:
+        dq = np.abs([math.log(r["Gq_fit"] / r["Gq_prof"]) for r in iso])
+        dw = np.abs([r["w_fit"] - r["w_prof"] for r in iso])
+        cl = np.mean([class_of(r["Gq_fit"]) == class_of(r["Gq_prof"]) for r in iso])
+        lines.append(f"* ISO fit of the window: median abs ln Gq {np.median(dq):.3f}, median abs w err "
+                     f"{np.median(dw):.3f}, profile w median {np.median([r['w_prof'] for r in iso]):.2f}, "
+                     f"fitted w median {np.median([r['w_fit'] for r in iso]):.2f}, class right {100 * cl:.0f}%")
+    poor = np.mean([(r.get("fit_quality") or {}).get("status") == "poor" for r in rs])
+    lines.append(f"* flagged poor by the fit-quality gate: {100 * poor:.0f}%")
+    return "\n".join(lines)
+
+
+def report(cases: list) -> str:
+    """The table over all cases; with several scenarios also one table per scenario."""
+    scens = sorted({c.get("scenario", "") for c in cases})
+    out = []
+    if len(scens) > 1:
+        out.append(f"## all {len(cases)} drives\n\n" + table(cases))
+        for sc in scens:
+            sub = [c for c in cases if c.get("scenario", "") == sc]
+            out.append(f"## {sc}: {len(sub)} drives\n\n" + table(sub))
+    else:
+        out.append(table(cases))
+    pt = profile_table(cases)
+    if pt:
+        out.append(pt)
+    return "\n\n".join(out)
 
 
 if __name__ == "__main__":
