@@ -4,6 +4,9 @@ What this module is for: the *target* spectra a road is generated from or
 classified against -- the ISO 8608 displacement PSD Gd(n) = Gd(n0) (n/n0)^-w,
 the classes A-H with their geometric means and bounds, the class of a given
 PSD level, and the anisotropic two-dimensional surface PSD (the paper's eq (5)).
+A fitted two-slope form (:func:`two_slope_psd`, one break frequency and two
+waviness exponents; :func:`road_psd` picks one or two slopes) describes real roads
+whose spectrum bends.
 What it is not: a generator (``roadlib.synthesis``) or an estimator of the PSD
 of measured data (``roadlib.metrics``).
 
@@ -164,6 +167,114 @@ def iso_psd(n, gd0: float, w: float = 2.0) -> np.ndarray:
     if np.any(n <= 0):
         raise EroadInputError("iso_psd: spatial frequencies n must be > 0 cycles/m")
     return gd0 * (n / N0) ** (-w)
+
+
+def _check_two_slope(w2, n_break):
+    if (w2 is None) != (n_break is None):
+        raise EroadInputError("two-slope PSD: give both w2 and n_break, or neither (one slope)")
+    if w2 is None:
+        return
+    if not (np.isfinite(w2) and 0 < w2 < 6):
+        raise EroadInputError(f"waviness above the break w2 must be in (0, 6), got {w2!r}")
+    if not (np.isfinite(n_break) and n_break > 0):
+        raise EroadInputError(f"break frequency n_break must be positive and finite [cycles/m], got {n_break!r}")
+
+
+def two_slope_psd(n, gd0: float, w1: float, w2: float, n_break: float) -> np.ndarray:
+    """Two-slope displacement PSD, continuous at the break [m^3].
+
+    ``Gd(n) = gd0 (n/n0)^-w1`` for n <= n_break and
+    ``Gd(n) = gd0 (n_break/n0)^-w1 (n/n_break)^-w2`` above: ISO 8608 fits a straight
+    line in log-log, and allows a fit by more than one line where the measured
+    spectrum bends; roads commonly fall off more steeply at long wavelengths than at
+    short ones (Andren 2006, Int. J. Vehicle Design 40; Kropac and Mucka 2004,
+    Int. J. Vehicle Design 36).  ``gd0`` keeps its meaning, Gd(n0), when
+    n0 <= n_break; for n_break < n0 it is the level the LOW-frequency line would
+    reach at n0 (the extrapolated line; Gd(n0) itself is :func:`road_psd` at n0).
+
+    Parameters
+    ----------
+    n : array_like
+        Spatial frequency [cycles/m], > 0.
+    gd0 : float
+        Level of the low-frequency line at n0 = 0.1 cycles/m [m^3].
+    w1, w2 : float
+        Waviness below and above the break [-].
+    n_break : float
+        Break frequency [cycles/m], > 0.
+
+    Returns
+    -------
+    ndarray
+        Gd(n) [m^3], the shape of ``n``.
+    """
+    _check_level(gd0, w1)
+    _check_two_slope(w2, n_break)
+    n = np.asarray(n, dtype=float)
+    if np.any(n <= 0):
+        raise EroadInputError("two_slope_psd: spatial frequencies n must be > 0 cycles/m")
+    low = gd0 * (n / N0) ** (-w1)
+    high = gd0 * (n_break / N0) ** (-w1) * (n / n_break) ** (-w2)
+    return np.where(n <= n_break, low, high)
+
+
+def road_psd(n, gd0: float, w: float = 2.0, w2: float | None = None,
+             n_break: float | None = None) -> np.ndarray:
+    """One-sided displacement PSD of a road: :func:`iso_psd` (one slope, ``w2`` and
+    ``n_break`` None -- exactly the ISO call, bit for bit) or :func:`two_slope_psd`
+    with ``w1 = w``.
+
+    Returns
+    -------
+    ndarray
+        Gd(n) [m^3].
+    """
+    _check_two_slope(w2, n_break)
+    if w2 is None:
+        return iso_psd(n, gd0, w)
+    return two_slope_psd(n, gd0, w, w2, n_break)
+
+
+def local_waviness(n, w: float, w2: float | None = None, n_break: float | None = None) -> np.ndarray:
+    """Local log-log slope (negated) of :func:`road_psd` at ``n`` [-]: ``w`` below
+    the break (everywhere for one slope), ``w2`` above."""
+    n = np.asarray(n, dtype=float)
+    if w2 is None:
+        return np.full(n.shape, float(w))
+    return np.where(n <= n_break, float(w), float(w2))
+
+
+def _power_integral(c: float, w: float, a: float, b: float) -> float:
+    """integral_a^b c n^-w dn (closed form; the logarithm at w = 1)."""
+    if b <= a:
+        return 0.0
+    if abs(w - 1.0) < 1e-12:
+        return c * math.log(b / a)
+    return c * (b ** (1.0 - w) - a ** (1.0 - w)) / (1.0 - w)
+
+
+def band_variance(gd0: float, w: float, nmin: float, nmax: float, w2: float | None = None,
+                  n_break: float | None = None) -> float:
+    """Variance [m^2] of a profile with PSD :func:`road_psd` over [nmin, nmax]
+    (closed form: each straight piece integrates to a power of n).
+
+    Parameters
+    ----------
+    gd0, w, w2, n_break
+        As :func:`road_psd`.
+    nmin, nmax : float
+        Band [cycles/m], 0 < nmin < nmax.
+    """
+    _check_level(gd0, w)
+    _check_two_slope(w2, n_break)
+    if not (0 < nmin < nmax):
+        raise EroadInputError(f"band_variance: need 0 < nmin < nmax, got {nmin}, {nmax}")
+    c1 = gd0 * N0 ** w
+    if w2 is None:
+        return _power_integral(c1, w, nmin, nmax)
+    c2 = gd0 * (n_break / N0) ** (-w) * n_break ** w2
+    return (_power_integral(c1, w, nmin, min(nmax, n_break))
+            + _power_integral(c2, w2, max(nmin, n_break), nmax))
 
 
 def lateral_density(n_y, n_x, w: float = 2.0, lam: float = 1.0) -> np.ndarray:

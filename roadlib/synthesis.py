@@ -16,7 +16,8 @@ The model (docs/roadlib.md has the derivation)::
     a_kl^2 / 2 = Gd(n_k) dn q_kl,     q_kl = p(m_l | n_k) / sum_l p(m_l | n_k)
     phi_kl ~ U[0, 2 pi) independent
 
-``Gd`` is the one-sided ISO PSD and ``p`` the lateral density of the surface PSD
+``Gd`` is the one-sided ISO PSD (or, with ``w2`` and ``n_break``, the two-slope
+PSD of ``roadlib.psd.two_slope_psd``) and ``p`` the lateral density of the surface PSD
 (``roadlib.psd.lateral_density``, eq (5)).  Because sum_l q_kl = 1, every
 longitudinal track z(x, y0) has the 1D PSD Gd(n_k) at every harmonic exactly in
 expectation, whatever lam; lam only moves variance between lateral
@@ -51,7 +52,7 @@ import numpy as np
 import scipy.fft
 
 from eroad.errors import EroadInputError
-from roadlib.psd import ISO_BAND, ISO_CLASSES, class_gd0, iso_psd, lateral_density
+from roadlib.psd import ISO_BAND, ISO_CLASSES, _check_two_slope, class_gd0, lateral_density, road_psd
 
 #: lateral period of the surface harmonics, as a multiple of the road width
 #: (plus one dy): wide enough that the field does not repeat across the road
@@ -82,6 +83,12 @@ class SpectralParams:
     lam : float
         Anisotropy factor [-] of the surface PSD (eq (5)); 1 is isotropic,
         > 1 more coherent across the road.
+    w2, n_break : float, optional
+        A two-slope spectrum (``roadlib.psd.two_slope_psd``): waviness ``w2`` [-]
+        above the break frequency ``n_break`` [cycles/m], ``w`` below it.  Both or
+        neither; None (default) is the one-slope ISO spectrum, synthesised exactly as
+        before the option existed (same bytes).  The lateral density of a surface
+        uses the local waviness (``w`` below the break, ``w2`` above).
 
     Raises
     ------
@@ -96,6 +103,8 @@ class SpectralParams:
     dx: float = 0.1
     dy: float = 0.1
     lam: float = 1.0
+    w2: float | None = None
+    n_break: float | None = None
 
     def __post_init__(self):
         for name in ("Gq_n0", "w", "nmin", "nmax", "dx", "dy", "lam"):
@@ -109,6 +118,19 @@ class SpectralParams:
             object.__setattr__(self, name, v)
         if not self.w < 6:
             raise EroadInputError(f"SpectralParams.w = {self.w} is outside (0, 6)")
+        for name in ("w2", "n_break"):
+            v = getattr(self, name)
+            if v is None:
+                continue
+            try:
+                v = float(v)
+            except (TypeError, ValueError):
+                raise EroadInputError(f"SpectralParams.{name} must be a number, got {v!r}") from None
+            object.__setattr__(self, name, v)
+        try:
+            _check_two_slope(self.w2, self.n_break)
+        except EroadInputError as e:
+            raise EroadInputError(f"SpectralParams: {e}") from None
         h_top = ISO_CLASSES["H"].nominal_bounds[1]
         if self.Gq_n0 >= h_top:
             raise EroadInputError(
@@ -130,8 +152,18 @@ class SpectralParams:
         return cls(Gq_n0=class_gd0(name), **kw)
 
     def to_dict(self) -> dict:
-        """Plain dict (for metadata / JSON)."""
-        return asdict(self)
+        """Plain dict (for metadata / JSON); ``w2`` and ``n_break`` only for a
+        two-slope spectrum (a one-slope dict is what it was before they existed)."""
+        d = asdict(self)
+        if self.w2 is None:
+            d.pop("w2")
+            d.pop("n_break")
+        return d
+
+    @property
+    def two_slope(self) -> bool:
+        """True for a two-slope spectrum (``w2`` and ``n_break`` given)."""
+        return self.w2 is not None
 
     @property
     def nyquist(self) -> float:
@@ -328,7 +360,7 @@ def harmonic_field(params: SpectralParams, length: float, width: float = 0.0,
             f"at frequency step {dn:.3g} cycles/m; widen the band or lengthen the road")
     k = np.flatnonzero(weight > 0)
     n = k * dn
-    gd = iso_psd(n, params.Gq_n0, params.w)
+    gd = road_psd(n, params.Gq_n0, params.w, params.w2, params.n_break)
     if lateral is None:
         lateral = width > 0
     if lateral:
@@ -337,6 +369,10 @@ def harmonic_field(params: SpectralParams, length: float, width: float = 0.0,
         l_max = int(math.ceil(1.0 / (2.0 * params.dy) / dm)) - 1     # |m_l| < 1/(2 dy)
         m = np.arange(-l_max, l_max + 1) * dm
         p = lateral_density(m[None, :], n[:, None], params.w, params.lam)
+        if params.two_slope:   # local waviness above the break
+            hi = n > params.n_break
+            if np.any(hi):
+                p[hi] = lateral_density(m[None, :], n[hi, None], params.w2, params.lam)
         q = p / p.sum(axis=1, keepdims=True)
     else:
         m = np.zeros(1)

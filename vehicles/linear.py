@@ -492,15 +492,20 @@ def _speed(speed) -> float:
 
 
 def _road_dict(road) -> dict:
-    """Gq_n0, w, nmin, nmax, lam from SpectralParams or a dict (validated)."""
+    """Gq_n0, w, nmin, nmax, lam from SpectralParams or a dict (validated); plus
+    ``w2`` and ``n_break`` for a two-slope road (``roadlib.psd.two_slope_psd``;
+    both or neither)."""
     from roadlib.synthesis import SpectralParams
 
     if isinstance(road, SpectralParams):
-        return {"Gq_n0": road.Gq_n0, "w": road.w, "nmin": road.nmin, "nmax": road.nmax,
-                "lam": road.lam}
+        out = {"Gq_n0": road.Gq_n0, "w": road.w, "nmin": road.nmin, "nmax": road.nmax,
+               "lam": road.lam}
+        if road.w2 is not None:
+            out.update(w2=road.w2, n_break=road.n_break)
+        return out
     if not isinstance(road, dict):
         raise EroadInputError(f"road must be SpectralParams or a dict, got {type(road).__name__}")
-    known = {"Gq_n0", "w", "nmin", "nmax", "lam", "dx", "dy"}
+    known = {"Gq_n0", "w", "nmin", "nmax", "lam", "dx", "dy", "w2", "n_break"}
     bad = set(road) - known
     if bad:
         raise EroadInputError(f"road parameters: unknown key(s) {', '.join(sorted(bad))}")
@@ -509,6 +514,11 @@ def _road_dict(road) -> dict:
     from roadlib.psd import ISO_BAND
     out = {"Gq_n0": road["Gq_n0"], "w": road.get("w", 2.0), "nmin": road.get("nmin", ISO_BAND[0]),
            "nmax": road.get("nmax", ISO_BAND[1]), "lam": road.get("lam", 1.0)}
+    two = [k for k in ("w2", "n_break") if road.get(k) is not None]
+    if len(two) == 1:
+        raise EroadInputError("road parameters: a two-slope road needs both 'w2' and 'n_break'")
+    if two:
+        out.update(w2=road["w2"], n_break=road["n_break"])
     for k, v in out.items():
         if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
             raise EroadInputError(f"road parameters: {k} must be a positive number, got {v!r}")
@@ -523,7 +533,9 @@ def temporal_road_psd(road, speed: float, freqs) -> np.ndarray:
     Parameters
     ----------
     road : SpectralParams or dict
-        ``Gq_n0`` [m^3], ``w`` [-], ``nmin``, ``nmax`` [cycles/m].
+        ``Gq_n0`` [m^3], ``w`` [-], ``nmin``, ``nmax`` [cycles/m]; optional ``w2`` [-]
+        and ``n_break`` [cycles/m] for a two-slope spectrum
+        (``roadlib.psd.two_slope_psd``, ``w`` below the break, ``w2`` above).
     speed : float
         [m/s].
     freqs : array_like
@@ -534,7 +546,7 @@ def temporal_road_psd(road, speed: float, freqs) -> np.ndarray:
     ndarray
         [m^2/Hz]; zero outside ``nmin v <= f <= nmax v``.
     """
-    from roadlib.psd import iso_psd
+    from roadlib.psd import road_psd
 
     v = _speed(speed)
     p = _road_dict(road)
@@ -542,7 +554,7 @@ def temporal_road_psd(road, speed: float, freqs) -> np.ndarray:
     n = f / v
     inside = (n >= p["nmin"]) & (n <= p["nmax"])
     G = np.zeros_like(f)
-    G[inside] = iso_psd(n[inside], p["Gq_n0"], p["w"]) / v
+    G[inside] = road_psd(n[inside], p["Gq_n0"], p["w"], p.get("w2"), p.get("n_break")) / v
     return G
 
 
