@@ -76,7 +76,7 @@ def oracle_fits(dataset: Path, truth: dict, track_y=(-0.9, 0.9)) -> list:
 REF_TRACK_Y = (-0.93, 0.93)
 #: half-width of the band over which the profile's periodogram is averaged around a
 #: frequency n: [n / B, n B] with B = 2^(1/6), one third of an octave.  For a power law of
-#: waviness 2-3.5 the band mean differs from the value at n by < 1.6 % (band_mean_bias).
+#: waviness 1.5-3.5 the band mean differs from the value at n by < 1.2 % (band_mean_bias).
 THIRD_OCTAVE = 2.0 ** (1.0 / 6.0)
 
 

@@ -14,10 +14,18 @@ misfit) and
   ln Gq(n0), w and ln G(n_best), the share flagged 'poor' by the gate, and the coverage
   of the noise-only Laplace intervals for comparison.
 
+With ``--by-scenario`` a set whose drives come from several scenarios (the second truth
+family: ``second`` on synthetic roads, ``second_measured`` on the measured profile) is
+also scored per scenario; with ``--profile`` the measured-road drives are also scored
+segment by segment against the profile under each FITTED segment (the records'
+``profile`` rows: the window's ISO fit and its periodogram at n_best), as
+``NAME/profile``.  A second table gives the accuracy targets: G(1 cycle/m) within 20 %
+and class right.
+
 Usage::
 
     python benchmarks/calibrate_uncertainty.py null=/tmp/cal/null random=/tmp/cal/random \
-        [--calibrate null]
+        [--calibrate null] [--by-scenario] [--profile]
 
 Nothing is written; the printout is what results/inverse_blind/<run>/README.md quotes.
 """
@@ -37,13 +45,32 @@ QUANTITIES = {"ln_Gq_n0": ("lnGq_err", lambda r: r["sd_laplace"]["ln_Gq_n0"]),
               "ln_G_n_best": ("lnG_n_best_err", lambda r: r["sd_ln_G_n_best_laplace"])}
 
 
-def load(root: Path, min_s: float = 3.0) -> list:
+def profile_rows(case: dict, min_s: float = 3.0) -> list:
+    """A measured-road drive's fitted segments as scoring rows against the profile under them."""
+    import math
+
+    from roadlib.psd import class_of
+
+    rows = []
+    for r in case.get("profile", []):
+        if r["duration_s"] < min_s or "Gq_prof" not in r or "lnG_n_best_err" not in r:
+            continue
+        rows.append(dict(r, lnGq_err=math.log(r["Gq_fit"] / r["Gq_prof"]), w_err=r["w_fit"] - r["w_prof"],
+                         class_true=class_of(r["Gq_prof"]), class_fit=class_of(r["Gq_fit"])))
+    return rows
+
+
+def load(root: Path, min_s: float = 3.0, profile: bool = False) -> list:
+    """Rows of segments >= ``min_s`` (true segments; with ``profile`` the measured-road drives'
+    fitted segments against the profile instead, :func:`profile_rows`)."""
     rows = []
     for line in (root / "results.jsonl").read_text().splitlines():
         case = json.loads(line)
-        for r in case.get("segments", []):
+        segs = profile_rows(case, min_s) if profile else case.get("segments", [])
+        for r in segs:
             if r["duration_s"] >= min_s and "lnGq_err" in r:
                 r["seed"] = case["seed"]
+                r["scenario"] = case.get("scenario", "")
                 # records made before the pipeline reported honest sd hold the Laplace ones
                 r.setdefault("sd_laplace", {"ln_Gq_n0": r["sd_ln_Gq_n0"], "w": r["sd_w"]})
                 r.setdefault("sd_ln_G_n_best_laplace", r.get("sd_ln_G_n_best"))
@@ -102,6 +129,17 @@ def coverage(rows: list, const: dict) -> dict:
     return res
 
 
+def accuracy(rows: list) -> dict:
+    """Shares of segments with G(1 cycle/m) within 20 % and with the class right."""
+    import math
+
+    g1 = [abs(r["lnG_1cpm_err"]) if "lnG_1cpm_err" in r else r.get("dlnG_1cpm") for r in rows]
+    g1 = np.array([g for g in g1 if g is not None], float)
+    cl = [r["class_true"] == r["class_fit"] for r in rows if "class_true" in r]
+    return {"n": len(rows), "g1": (float(np.mean(g1 <= math.log(1.2))) if g1.size else float("nan"), g1.size),
+            "class": (float(np.mean(cl)) if cl else float("nan"), len(cl))}
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("sets", nargs="+", metavar="NAME=ROOT")
@@ -109,11 +147,27 @@ def main(argv=None) -> int:
     ap.add_argument("--min-s", type=float, default=3.0, help="shortest true segment scored [s]")
     ap.add_argument("--beta-from", default=None, metavar="NAME",
                     help="choose the model-form term BETA on this set (drives with a model gap)")
+    ap.add_argument("--by-scenario", action="store_true",
+                    help="also score each set's scenarios apart (NAME/SCENARIO)")
+    ap.add_argument("--profile", action="store_true",
+                    help="also score measured-road drives per fitted segment against the profile (NAME/profile)")
     a = ap.parse_args(argv)
     sets = {}
     for item in a.sets:
         name, _, root = item.partition("=")
         sets[name] = load(Path(root), a.min_s)
+    extra = {}
+    for name in list(sets):
+        root = Path(dict(i.partition("=")[::2] for i in a.sets)[name])
+        if a.by_scenario:
+            scens = sorted({r["scenario"] for r in sets[name]})
+            if len(scens) > 1:
+                for sc in scens:
+                    extra[f"{name}/{sc}"] = [r for r in sets[name] if r["scenario"] == sc]
+        if a.profile:
+            pr = load(root, a.min_s, profile=True)
+            if pr:
+                extra[f"{name}/profile"] = pr
     const = {"R_REF": U.R_REF, "R_GATE": U.R_GATE, "KAPPA": dict(U.KAPPA), "BETA": dict(U.BETA)}
     if a.calibrate:
         const = calibrate(sets[a.calibrate])
@@ -135,8 +189,13 @@ def main(argv=None) -> int:
               + " | ".join(f"{100 * c[q][0]:.0f} %" for q in QUANTITIES) + " | "
               + " | ".join(f"{100 * c[q][1]:.0f} %" for q in QUANTITIES) + " |")
 
-    for name, rows in sets.items():
+    for name, rows in {**sets, **extra}.items():
         line(name, coverage(rows, const))
+    print("\n| set | segments >= %g s | G(1 cycle/m) within 20 %% | class right |" % a.min_s)
+    print("|---|---|---|---|")
+    for name, rows in {**sets, **extra}.items():
+        c = accuracy(rows)
+        print(f"| {name} | {c['n']} | {100 * c['g1'][0]:.0f} % | {100 * c['class'][0]:.0f} % |")
     if a.calibrate:   # out of sample on the calibration family: odd seeds calibrate even ones and back
         rows = sets[a.calibrate]
         for part, other in ((1, 0), (0, 1)):
