@@ -343,7 +343,7 @@ class LinearFeatures:
         The closed form r^nu K_nu(r) / (Gamma(nu) 2^(nu-1)) (nu = w/2,
         :func:`vehicles.linear.surface_coherence`) is tabulated per w on
         ``COHERENCE_TABLE`` points log-spaced in r and interpolated linearly in ln r
-        (largest error 4e-5 for w in 1.2-3, checked against the closed form on 1e5
+        (largest error 4e-5 for w in 1.2-3.5, checked against the closed form on 1e5
         random r); cached per (window, w), since the fit's star design moves w in
         2 of its 8 samples."""
         from vehicles.linear import surface_coherence
@@ -365,45 +365,76 @@ class LinearFeatures:
         return out
 
     def band_powers(self, params) -> list:
-        """Expected noise-free band powers, per window (n_channels, n_bands) [unit^2]."""
+        """Expected noise-free band powers, per window (n_channels, n_bands) [unit^2].
+
+        ``params`` is (K, 4) (Gq_n0, w, nmin, nmax) or (K, 6) with a two-slope road's
+        ``w2`` [-] and ``n_break`` [cycles/m] in the last two columns (NaN there: one
+        slope; :meth:`window_band_powers`)."""
         P = np.atleast_2d(np.asarray(params, dtype=float))
-        if P.shape != (self.n_segments, 4):
-            raise EroadInputError(f"linear features: params must have shape ({self.n_segments}, 4), got {P.shape}")
-        out = []
-        for k, (win, (Gq, w, nmin, nmax)) in enumerate(zip(self._win, P)):
-            ff = win["ff"]
-            gams = self._coherence(k, w)
-            S = np.zeros((win["T"].shape[2], ff.size))
-            for i, v in enumerate(win["speeds"]):
-                n = ff / v
+        if P.shape not in ((self.n_segments, 4), (self.n_segments, 6)):
+            raise EroadInputError(f"linear features: params must have shape ({self.n_segments}, 4) or "
+                                  f"({self.n_segments}, 6), got {P.shape}")
+        return [self.window_band_powers(k, row) for k, row in enumerate(P)]
+
+    def window_band_powers(self, k: int, row) -> np.ndarray:
+        """Expected noise-free band powers of window ``k``, (n_channels, n_bands) [unit^2].
+
+        ``row``: (Gq_n0, w, nmin, nmax) or (Gq_n0, w, nmin, nmax, w2, n_break).  A
+        two-slope road (``roadlib.psd.two_slope_psd``: ``w`` below ``n_break``, ``w2``
+        above, continuous) takes the surface coherence of the local waviness (the
+        synthesis's lateral density, ``roadlib.synthesis``); with ``w2`` NaN or absent
+        the one-slope expression is evaluated exactly as before the option existed."""
+        win = self._win[k]
+        Gq, w, nmin, nmax = (float(x) for x in row[:4])
+        two = len(row) > 4 and math.isfinite(float(row[4]))
+        ff = win["ff"]
+        gams = self._coherence(k, w)
+        if two:
+            w2, nb = float(row[4]), float(row[5])
+            gams2 = self._coherence(k, w2)
+        S = np.zeros((win["T"].shape[2], ff.size))
+        for i, v in enumerate(win["speeds"]):
+            n = ff / v
+            if not two:
                 G = Gq * (n / N0) ** (-w) / v * _edge_weights(ff, nmin * v, nmax * v)
                 gam = gams[i]                                        # (n_dy, n_fine)
-                S += G[None, :] * np.einsum("gf,gof->of", gam, win["T"][i])
-            S /= win["speeds"].size
-            out.append(S @ win["BK"].T)                              # (n_ch, n_bands)
-        return out
+            else:
+                below = n <= nb
+                shape = np.where(below, (n / N0) ** (-w), (nb / N0) ** (-w) * (n / nb) ** (-w2))
+                G = Gq * shape / v * _edge_weights(ff, nmin * v, nmax * v)
+                gam = np.where(below[None, :], gams[i], gams2[i])
+            S += G[None, :] * np.einsum("gf,gof->of", gam, win["T"][i])
+        S /= win["speeds"].size
+        return S @ win["BK"].T                                       # (n_ch, n_bands)
+
+    def window_features(self, k: int, row, Pb=None) -> np.ndarray:
+        """Expected features of window ``k`` at one segment's parameters ``row`` (4 or
+        6 values, :meth:`window_band_powers`), with this object's offsets -- what
+        :meth:`__call__` returns for that window."""
+        win = self._win[k]
+        if Pb is None:
+            Pb = self.window_band_powers(k, row)
+        extra = getattr(self, "extra", None)
+        tot = np.maximum(Pb + win["noise"], 1e-300)
+        parts, pos = [], 0
+        for j, (sel, allb, bb, br) in enumerate(win["sel"]):
+            add = 0.0 if extra is None else extra[k][pos:pos + sel.size]
+            parts.append(np.log(tot[j, sel] + add) + bb)
+            pos += sel.size
+            if self.features.spec.include_rms:
+                parts.append(np.array([0.5 * math.log(tot[j, allb].sum()) + br]))
+                pos += 1
+        F = np.concatenate(parts)
+        if self.offsets is not None:
+            F = F + self.offsets[k]
+        return F
 
     def __call__(self, params, seed=None) -> list:
         """Expected features of every window, aligned with ``features.windows[k].y``
         (``seed`` is ignored: the expectation has no realisation)."""
         self.n_evals += 1
-        out = []
-        extra = getattr(self, "extra", None)
-        for k, (win, Pb) in enumerate(zip(self._win, self.band_powers(params))):
-            tot = np.maximum(Pb + win["noise"], 1e-300)
-            parts, pos = [], 0
-            for j, (sel, allb, bb, br) in enumerate(win["sel"]):
-                add = 0.0 if extra is None else extra[k][pos:pos + sel.size]
-                parts.append(np.log(tot[j, sel] + add) + bb)
-                pos += sel.size
-                if self.features.spec.include_rms:
-                    parts.append(np.array([0.5 * math.log(tot[j, allb].sum()) + br]))
-                    pos += 1
-            F = np.concatenate(parts)
-            if self.offsets is not None:
-                F = F + self.offsets[k]
-            out.append(F)
-        return out
+        P = np.atleast_2d(np.asarray(params, dtype=float))
+        return [self.window_features(k, P[k], Pb) for k, Pb in enumerate(self.band_powers(params))]
 
 
 def simulated_features(simulate, features: FeatureSet, params, seeds, map_fn=map) -> list:
@@ -471,6 +502,8 @@ def fit_hybrid(simulate, features: FeatureSet, params0, *, linear: LinearFeature
         iterations (``stage``: 'linear', 'corrected_1', ...; ``n_sims`` time
         simulations so far, ``n_evals`` linear evaluations of the stage) and one entry
         ``kind: 'correction'`` per simulation round (offsets' rms, largest |offset|).
+        ``linear_features``: the :class:`LinearFeatures` of the last stage, with the
+        offsets it was fitted with (``inverse.road_model`` uses them).
     """
     from dataclasses import replace
 
@@ -499,6 +532,7 @@ def fit_hybrid(simulate, features: FeatureSet, params0, *, linear: LinearFeature
         return res
 
     res = stage(linear, "linear", params0, linear_max_iter)
+    final = linear
     sim_seeds = ([int(seed)] + polish_seeds(seed, max(int(realisations) - 1, 0)))[:max(int(realisations), 1)]
     reps = features.spec.replicates
     for r in range(1, int(corrections) + 1):
@@ -531,7 +565,8 @@ def fit_hybrid(simulate, features: FeatureSet, params0, *, linear: LinearFeature
         history.append(entry)
         if progress is not None:
             progress(entry)
-        new = stage(linear.with_offsets(off, extra), f"corrected_{r}", p_at, config.max_iter)
+        final = linear.with_offsets(off, extra)
+        new = stage(final, f"corrected_{r}", p_at, config.max_iter)
         move = float(np.max(np.abs(new.theta - res.theta) / np.asarray(config.scale, float)))
         history[-1]["move"] = move
         res = new
@@ -540,4 +575,7 @@ def fit_hybrid(simulate, features: FeatureSet, params0, *, linear: LinearFeature
     res.history = history
     res.n_sims = n_sims
     res.wall_s = _time.perf_counter() - t0
+    # the linear features of the last stage, with its offsets (inverse.road_model refits
+    # the road's spectral form on them)
+    res.linear_features = final
     return res
