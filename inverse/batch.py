@@ -1,0 +1,208 @@
+"""Many drives inverted on Dask: ``eroad invert DIR1 DIR2 ... --out ROOT [--scheduler ADDRESS]``.
+
+What it is for: one inversion per dataset, each an ordinary run folder ``ROOT/<dataset
+folder name>/`` (what :func:`inverse.run.run_inversion` writes, with its archive record
+``run.json``), the drives spread over the workers of a ``dask.distributed`` cluster:
+a new ``LocalCluster`` of ``n_workers`` processes with one thread each by default, or
+an existing cluster given by its scheduler address -- the conventions of the sweeps
+(``studies.sweep.dask_client``; this module sits below ``studies`` and so does not
+import it).  A drive that fails does not stop the others: its one-line error is
+reported, its folder holds a ``run.json`` with status ``failed`` (unless the folder
+already held something), and ``ROOT/batch.json`` lists every drive's outcome.
+
+What it is not: parallel inside a drive -- each drive runs serially in its worker
+(Dask's worker processes are daemonic and cannot start a process pool), the cluster
+gives the parallelism across drives.  Nor the command line (``inverse.cli``).
+
+The function run per drive is named by reference (``"module:function"``, default
+``inverse.run:run_inversion``) so a caller above this layer can hand in its own (the
+CLI's closed loop, ``diagnosis.closed_loop:invert_closed_loop``) without this module
+importing it.  Workers of an existing cluster must have eroad installed.
+"""
+from __future__ import annotations
+
+import contextlib
+import importlib
+import logging
+import os
+import time as _time
+from pathlib import Path
+
+from eroad.errors import EroadInputError
+
+__all__ = ["invert_many", "run_folder_names", "DEFAULT_RUNNER", "BATCH_FILE"]
+
+#: the function run per drive
+DEFAULT_RUNNER = "inverse.run:run_inversion"
+#: the batch's record under ROOT
+BATCH_FILE = "batch.json"
+
+
+def run_folder_names(datasets) -> list:
+    """Run folder names under ROOT: each dataset folder's name; duplicates refused (one line)."""
+    names = [Path(d).resolve().name for d in datasets]
+    seen = {}
+    for d, n in zip(datasets, names):
+        if n in seen:
+            raise EroadInputError(f"{seen[n]} and {d}: two datasets with the folder name {n!r}; "
+                                  "their run folders under --out would collide (rename one)")
+        seen[n] = d
+    return names
+
+
+def silent(message: str) -> None:
+    """A progress callback that says nothing (runners' progress lines stay in the worker)."""
+
+
+def _resolve(ref: str):
+    mod, _, name = ref.partition(":")
+    return getattr(importlib.import_module(mod), name)
+
+
+def one_line(exc: BaseException) -> str:
+    """An exception as one line: the message of an EroadInputError, else ``Type: message``."""
+    msg = " ".join(str(exc).split())
+    if isinstance(exc, EroadInputError):
+        return msg or type(exc).__name__
+    return f"{type(exc).__name__}: {msg}" if msg else type(exc).__name__
+
+
+def _invert_one(runner: str, dataset: str, out: str, kwargs: dict, argv: list) -> dict:
+    """Run one drive (in a worker); never raises: a failure is returned with its one line."""
+    from eroad.archive import finish_run_info, run_info, write_run_json
+
+    t0 = _time.perf_counter()
+    out_p = Path(out)
+    existed = out_p.exists() and (not out_p.is_dir() or any(out_p.iterdir()))
+    record = run_info("invert", run_id=out_p.name, command=argv, seed=kwargs.get("seed"))
+    try:
+        summary = _resolve(runner)(dataset, out, argv=argv, **kwargs)
+    except Exception as exc:   # noqa: BLE001 - every failure is reported, the batch goes on
+        line = one_line(exc)
+        if not existed:       # an archived record of the failure; never over an existing folder
+            try:
+                out_p.mkdir(parents=True, exist_ok=True)
+                write_run_json(out_p, finish_run_info(record, "failed", wall_s=_time.perf_counter() - t0,
+                                                      error=exc))
+            except OSError:
+                pass
+        return {"dataset": dataset, "run": out, "status": "failed", "error": line,
+                "wall_s": _time.perf_counter() - t0}
+    segs = summary.get("segments", [])
+    e = summary.get("errors", {})
+    return {"dataset": dataset, "run": out, "status": "complete", "error": None,
+            "wall_s": _time.perf_counter() - t0, "classes": [s.get("class") for s in segs],
+            "fit_quality": summary.get("fit_quality", {}).get("status"),
+            "rms_err": {c: e[c].get("rms_err") for c in ("axle_acc_3L", "axle_acc_3R") if c in e}}
+
+
+@contextlib.contextmanager
+def _client(scheduler, n_workers: int, connect_timeout: float = 20.0):
+    """A quiet ``distributed.Client`` (the sweeps' settings), closed with its cluster on exit."""
+    import dask
+    from distributed import Client, LocalCluster
+
+    logger = logging.getLogger("distributed")
+    old = logger.level
+    logger.setLevel(logging.ERROR)
+    env_old = os.environ.get("DASK_LOGGING__DISTRIBUTED")
+    os.environ["DASK_LOGGING__DISTRIBUTED"] = "error"     # read by the worker processes at import
+    try:
+        with contextlib.ExitStack() as stack:
+            stack.enter_context(dask.config.set({"logging.distributed": "error"}))
+            if scheduler is None:
+                cluster = stack.enter_context(LocalCluster(
+                    n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0",
+                    scheduler_kwargs={"dashboard": False}, silence_logs=logging.ERROR))
+                client = stack.enter_context(Client(cluster, set_as_default=False))
+            else:
+                try:
+                    client = Client(scheduler, timeout=connect_timeout, set_as_default=False)
+                except (OSError, TimeoutError, ValueError) as exc:
+                    raise EroadInputError(f"--scheduler {scheduler}: cannot connect "
+                                          f"({type(exc).__name__}: {exc})") from None
+                stack.enter_context(client)
+            yield client
+    finally:
+        logger.setLevel(old)
+        if env_old is None:
+            os.environ.pop("DASK_LOGGING__DISTRIBUTED", None)
+        else:
+            os.environ["DASK_LOGGING__DISTRIBUTED"] = env_old
+
+
+def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: str = DEFAULT_RUNNER,
+                argv=None, report=None, **kwargs) -> list:
+    """Invert every dataset into ``root/<name>`` on a Dask cluster; one result per drive.
+
+    Parameters
+    ----------
+    datasets : sequence of str or Path
+        Dataset folders (their folder names must differ).
+    root : str or Path
+        Folder of the run folders (created; may exist).
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://host:8786``); default a new
+        ``LocalCluster`` of ``n_workers`` processes.
+    n_workers : int
+        Local worker processes (>= 1; ignored with ``scheduler``).
+    runner : str
+        ``"module:function"`` run per drive as ``function(dataset, out, argv=..., **kwargs)``,
+        returning the run's summary dict.
+    argv : list of str, optional
+        Command line recorded in each run.json.
+    report : callable, optional
+        Called with each drive's result as it finishes (the CLI prints one line).
+    **kwargs
+        Passed to the runner (``workers`` is set to 1: each drive runs serially).
+
+    Returns
+    -------
+    list of dict
+        Per dataset, in the given order: ``dataset``, ``run``, ``status``
+        (``complete``/``failed``), ``error`` (one line or None), ``wall_s``, and for a
+        complete run ``classes``, ``fit_quality``, ``rms_err`` (Table 2's medians).
+        Also written to ``root/batch.json``.
+    """
+    from eroad.archive import write_json_atomic
+
+    datasets = [str(d) for d in datasets]
+    if not datasets:
+        raise EroadInputError("eroad invert: no dataset given")
+    if not (isinstance(n_workers, int) and n_workers >= 1):
+        raise EroadInputError(f"--workers must be an integer >= 1, got {n_workers!r}")
+    root = Path(root)
+    if root.exists() and not root.is_dir():
+        raise EroadInputError(f"{root}: exists and is not a folder")
+    names = run_folder_names(datasets)
+    root.mkdir(parents=True, exist_ok=True)
+    kwargs = {**kwargs, "workers": 1}
+    argv = list(argv) if argv is not None else ["invert_many"]
+    t0 = _time.perf_counter()
+    results = [None] * len(datasets)
+    with _client(scheduler, n_workers) as client:
+        from distributed import as_completed
+
+        futures = {client.submit(_invert_one, runner, d, str(root / n), kwargs, argv, pure=False): i
+                   for i, (d, n) in enumerate(zip(datasets, names))}
+        try:
+            for fut in as_completed(list(futures), loop=client.loop):
+                i = futures.pop(fut)
+                try:
+                    r = fut.result()
+                except Exception as exc:   # noqa: BLE001 - a worker lost: that drive fails, not the batch
+                    r = {"dataset": datasets[i], "run": str(root / names[i]), "status": "failed",
+                         "error": one_line(exc), "wall_s": None}
+                results[i] = r
+                if report is not None:
+                    report(r)
+        finally:
+            if futures:
+                client.cancel(list(futures))
+    record = {"command": argv, "scheduler": scheduler or f"LocalCluster({n_workers} workers)",
+              "wall_s": round(_time.perf_counter() - t0, 3),
+              "n_complete": sum(r["status"] == "complete" for r in results),
+              "n_failed": sum(r["status"] == "failed" for r in results),
+              "runs": [{**r, "run": Path(r["run"]).name} for r in results]}
+    write_json_atomic(root / BATCH_FILE, record)
+    return results
