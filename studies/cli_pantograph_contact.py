@@ -7,6 +7,14 @@ force statistics (also with the base at rest), the lateral offset against the he
 width, ``data/contact.npz``, ``figures/contact.png`` and ``summary.json``
 (:func:`studies.pantograph_contact.run_pantograph_contact`).  ``--railway-reference``
 adds (or, without ``--road``, runs only) the railway reference case at 250 and 300 km/h.
+
+``eroad pantograph-contact --road FILE --out DIR --chassis-grid [--frames LIST]
+[--mounts LIST] [--workers N] [--run-dir DIR]`` runs the chassis-stiffness study in
+contact-force terms instead: one drive per frame x DCDC-mount stiffness configuration
+and one with the base still, in worker processes, into
+``DIR/pantograph_chassis/<run-id>/`` (or the named ``--run-dir``) with ``data/table.csv``,
+``data/table.md`` and ``figures/contact_vs_stiffness.png``
+(:func:`studies.pantograph_chassis.run_pantograph_chassis`).
 See ``docs/pantograph_contact.md``.
 """
 from __future__ import annotations
@@ -22,8 +30,30 @@ __all__ = ["register"]
 _positive = positive_float
 
 
+def _factor_list(text: str, allow_rigid: bool) -> tuple:
+    out = []
+    for part in text.split(","):
+        part = part.strip()
+        if allow_rigid and part.lower() == "rigid":
+            out.append("rigid")
+            continue
+        out.append(_positive(part))
+    if not out:
+        raise argparse.ArgumentTypeError("give at least one factor")
+    return tuple(out)
+
+
+def _frames(text: str) -> tuple:
+    return _factor_list(text, True)
+
+
+def _mounts(text: str) -> tuple:
+    return _factor_list(text, False)
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``eroad pantograph-contact`` to the top-level subparsers."""
+    from studies.sweep import add_sweep_arguments
     p = subparsers.add_parser(
         "pantograph-contact", help="pantograph on the e-tractor under a contact line: "
         "contact force statistics",
@@ -53,6 +83,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--railway-reference", action="store_true",
                    help="also run the railway reference case (250 and 300 km/h, about 1 min)")
     p.add_argument("--json", action="store_true", help="print summary.json")
+    g = p.add_argument_group(
+        "chassis-stiffness grid (--chassis-grid)",
+        "contact-force quality against frame and DCDC-mount stiffness: one drive per "
+        "configuration plus one with the base still; --frame-factor, --mount-factor, "
+        "--chassis, --no-compare and --railway-reference do not apply")
+    g.add_argument("--chassis-grid", action="store_true",
+                   help="run the frame x mount grid into DIR/pantograph_chassis/<run-id>/")
+    g.add_argument("--frames", type=_frames, default=None, metavar="LIST",
+                   help="frame stiffness factors, comma-separated, 'rigid' allowed "
+                   "(default 0.25,0.5,1,2,4,16,rigid)")
+    g.add_argument("--mounts", type=_mounts, default=None, metavar="LIST",
+                   help="DCDC mount stiffness factors, comma-separated (default 0.5,1,2)")
+    g.add_argument("--run-dir", default=None, metavar="DIR",
+                   help="write the grid run into this named folder (must not exist or be "
+                   "empty) instead of DIR/pantograph_chassis/<run-id>/")
+    add_sweep_arguments(p)
     p.set_defaults(func=_run)
 
 
@@ -67,6 +113,8 @@ def _run(args: argparse.Namespace) -> int:
 
     from studies.pantograph_contact import run_pantograph_contact
 
+    if args.chassis_grid:
+        return _run_grid(args)
     kw = {}
     if args.road is not None:
         kw = dict(speed_kmh=args.speed_kmh, duration=args.duration, line=args.line,
@@ -90,5 +138,39 @@ def _run(args: argparse.Namespace) -> int:
     for kmh, c in (s.get("reference") or {}).get("cases", {}).items():
         print(f"reference {kmh} km/h: {_fmt(c['stats'])}; inside published ranges: "
               f"{c['inside']}")
+    print(s["path"])
+    return 0
+
+
+def _run_grid(args: argparse.Namespace) -> int:
+    import sys
+
+    from eroad.errors import EroadInputError
+    from studies.pantograph_chassis import (FRAME_FACTORS, MOUNT_FACTORS,
+                                            run_pantograph_chassis)
+    from studies.sweep import sweep_kwargs
+
+    if args.road is None:
+        raise EroadInputError("--chassis-grid needs a road file (--road)")
+    if args.railway_reference:
+        raise EroadInputError("--chassis-grid and --railway-reference are separate runs")
+    s = run_pantograph_chassis(
+        args.road, args.out, run_dir=args.run_dir,
+        frames=args.frames or FRAME_FACTORS, mounts=args.mounts or MOUNT_FACTORS,
+        speed_kmh=args.speed_kmh, duration=args.duration, line=args.line,
+        pantograph=args.pantograph, dt=args.dt, command=sys.argv, **sweep_kwargs(args))
+    if args.json:
+        print(json.dumps(s, indent=2, default=str))
+        return 0
+    b = s["base_still"]
+    print(f"{s['n_configurations']} configurations at {s['speed_kmh']:g} km/h, "
+          f"{s['duration_s']:g} s drive")
+    print(f"contact force sd: {s['sd_N_range'][0]:.2f}-{s['sd_N_range'][1]:.2f} N "
+          f"(base still {b['sd_N']:.2f} N); base-induced sd "
+          f"{s['base_induced_sd_N_range'][0]:.2f}-{s['base_induced_sd_N_range'][1]:.2f} N")
+    print(f"contact loss: at most {s['max_loss_percent']:.2f} %; lowest unfiltered force "
+          f"{s['lowest_unfiltered_force_N']:.1f} N")
+    print(f"lateral offset: at most {s['max_lateral_offset_mm']:.1f} mm of half-width "
+          f"{s['head_half_width_mm']:.0f} mm")
     print(s["path"])
     return 0

@@ -1,0 +1,650 @@
+"""Chassis-stiffness study in contact-force terms: frame and DCDC-mount stiffness of the
+e-tractor against the contact-force quality of its pantograph under the contact line.
+
+What it is for (issue 18, item 5): the chassis-stiffness study
+(:mod:`studies.chassis_study`) reports how the frame and DCDC-mount stiffness move the
+band energies of the pantograph-base motion; an electrified-road engineer decides on the
+contact force instead.  For every frame x mount configuration this module runs one drive
+of :func:`studies.pantograph_contact.contact_drive` (tractor drive, DCDC-top motion by
+the paper's kinematics, its vertical part ``Tz`` fed into the lumped pantograph in
+penalty contact with the FE contact line, the lateral part through the head's lateral
+DOF) and reports the EN 50367-style statistics (mean, sd, Fm +/- 3 sd, actual min and
+max, contact loss) and the lateral offset against the head's half-width.  One extra run
+holds the base still on the same line, speed, travel and time grid; the difference
+``dF = F(drive) - F(base still)`` is the part of the contact force the base excitation
+causes, split into frequency bands (periodogram, Parseval-exact) together with the base
+velocity in the same bands.
+
+* :func:`study_cases` -- the case list (one per configuration plus the still base);
+* :func:`contact_case` -- the case function (module level, runs in a Dask worker
+  process; Exudyn holds the GIL, so parallel work needs processes);
+* :func:`band_rms` -- RMS of a signal per frequency band (periodogram);
+* :func:`collect` -- the table (one row per configuration and one for the still base);
+* :func:`plot_pantograph_chassis` -- the figure, from the saved table only;
+* :func:`run_pantograph_chassis` -- all of it, archived.
+
+Decisions: the road is one road file (default in the CLI: the identified road of the
+committed reference run); the drive is as long as the road allows at the speed (whole
+seconds, see :func:`studies.pantograph_contact.contact_drive`); statistics over the
+contact run after its first second, 20 Hz low-pass (EN 50318); contact loss from the
+unfiltered force.  The frame factors and mount factors default to the chassis study's.
+
+What it is not: a new tractor, pantograph or line model, or a road-realisation sweep (the
+chassis study's equivalent roads are not driven here; one road, one speed per run).
+"""
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import shutil
+import time as _time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from eroad.errors import EroadInputError
+
+__all__ = ["STUDY", "FRAME_FACTORS", "MOUNT_FACTORS", "FORCE_BANDS", "TABLE_COLUMNS",
+           "code_version", "study_cases", "contact_case", "band_rms", "collect",
+           "table_markdown", "plot_pantograph_chassis", "run_pantograph_chassis"]
+
+#: study name (folder under the results root)
+STUDY = "pantograph_chassis"
+#: frame stiffness factors (as the chassis-stiffness study; "rigid": one rigid body)
+FRAME_FACTORS: tuple = (0.25, 0.5, 1.0, 2.0, 4.0, 16.0, "rigid")
+#: DCDC mount stiffness factors (as the chassis-stiffness study)
+MOUNT_FACTORS: tuple = (0.5, 1.0, 2.0)
+#: bands of the base-induced force [Hz]: the chassis study's bands below 15 Hz, then
+#: 15-20 Hz (inside the EN 50318 20 Hz statistics window) and everything above 20 Hz
+#: (removed from the statistics by the low-pass, but present in the unfiltered force
+#: that decides contact loss); the upper edge None means the Nyquist frequency
+FORCE_BANDS: tuple = ((0.0, 0.5), (0.5, 5.0), (5.0, 15.0), (15.0, 20.0), (20.0, None))
+#: statistics start this long after the start of the contact run [s]
+T_START = 1.0
+#: sources whose content is part of the cache's code version
+_CODE_FILES = ("studies/pantograph_chassis.py", "studies/pantograph_contact.py",
+               "studies/figure11.py", "studies/pantograph.py", "studies/chassis_study.py",
+               "catenary/*.py", "catenary/data/*.toml", "vehicles/*.py",
+               "vehicles/effects/*.py", "vehicles/params/*.toml", "vehicles/data/*.toml",
+               "roadlib/*.py")
+
+
+def _band_label(band) -> str:
+    lo, hi = band
+    if hi is None:
+        return f">{lo:g}"
+    if lo == 0:
+        return f"<{hi:g}"
+    return f"{lo:g}-{hi:g}"
+
+
+#: the table's columns, in order (units in the names; ``frame`` "-" on the still row)
+TABLE_COLUMNS: tuple = (
+    "base", "frame", "mount", "frame_torsion_hz", "frame_bending_hz", "dcdc_bounce_hz",
+    "base_z_rms_mm", "base_vz_rms_mm_s",
+    "mean_N", "sd_N", "fm_minus_3sd_N", "fm_plus_3sd_N", "min_N", "max_N",
+    "unfiltered_min_N", "loss_percent",
+    "base_induced_sd_N", "base_az_rms_0_20Hz_m_s2", "inertia_scale_N",
+    *(f"dF_rms_{_band_label(b)}Hz_N" for b in FORCE_BANDS),
+    *(f"vz_rms_{_band_label(b)}Hz_mm_s" for b in FORCE_BANDS),
+    "lateral_max_mm", "lateral_rms_mm", "head_half_width_mm", "lateral_margin_mm",
+    "lateral_beyond_percent", "duration_s", "contact_wall_s")
+
+
+def code_version() -> str:
+    """Cache code-version token: ``eroad-<version>+<sha256 of the sources, 12 hex>`` over
+    this module, the contact study, the kinematics, the catenary and pantograph models
+    and their data, the vehicle models and roadlib (a change of any of them invalidates
+    the cached cases)."""
+    from eroad import __version__
+
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for pattern in _CODE_FILES:
+        for p in sorted(root.glob(pattern)):
+            h.update(p.relative_to(root).as_posix().encode())
+            h.update(p.read_bytes())
+    return f"eroad-{__version__}+{h.hexdigest()[:12]}"
+
+
+def _frame_value(frame):
+    if isinstance(frame, str) and frame.strip().lower() == "rigid":
+        return "rigid"
+    f = float(frame)
+    if not (math.isfinite(f) and f > 0):
+        raise EroadInputError(f"frame stiffness factor must be positive or 'rigid', got {frame!r}")
+    return f
+
+
+def study_cases(road_spec: dict, *, frames=FRAME_FACTORS, mounts=MOUNT_FACTORS,
+                speed_kmh: float = 80.0, duration: float = 30.0, t_skip: float = 1.0,
+                line: str = "truck_ohl", pantograph: str = "truck", dt: float = 1e-3,
+                vehicle: str = "e_tractor") -> list[dict]:
+    """Case list: every frame x mount configuration, then one case with the base still.
+
+    Parameters
+    ----------
+    road_spec : dict
+        A road spec of :func:`studies.chassis_study.road_specs` (``kind`` ``"file"``).
+    frames : sequence
+        Frame stiffness factors [-] and/or ``"rigid"``.
+    mounts : sequence of float
+        DCDC mount stiffness factors [-].
+    speed_kmh, duration, t_skip, line, pantograph, dt, vehicle
+        As :func:`studies.pantograph_contact.contact_drive`.
+
+    Returns
+    -------
+    list of dict
+        JSON-able cases for :func:`contact_case`; the still-base case is the last one
+        (frame 1, mount 1: its drive only sets the travel, its base motion is scaled by 0).
+    """
+    frames = [_frame_value(f) for f in frames]
+    mounts = [float(m) for m in mounts]
+    if not frames or not mounts:
+        raise EroadInputError("give at least one frame factor and one mount factor")
+    for m in mounts:
+        if not (math.isfinite(m) and m > 0):
+            raise EroadInputError(f"DCDC mount stiffness factor must be positive, got {m}")
+    if not (math.isfinite(speed_kmh) and 0 < speed_kmh <= 200):
+        raise EroadInputError(f"speed must be in (0, 200] km/h, got {speed_kmh}")
+    base = {"vehicle": str(vehicle), "road": road_spec, "speed_kmh": float(speed_kmh),
+            "duration": float(duration), "t_skip": float(t_skip), "line": str(line),
+            "pantograph": str(pantograph), "dt": float(dt)}
+    cases = [{**base, "frame": f, "mount": m, "base_scale": 1.0}
+             for m in mounts for f in frames]
+    cases.append({**base, "frame": 1.0, "mount": 1.0, "base_scale": 0.0})
+    return cases
+
+
+def band_rms(x, fs: float, bands=FORCE_BANDS, order: int = 0) -> np.ndarray:
+    """RMS of ``x`` (mean removed) in each frequency band, from the one-sided periodogram.
+
+    The squares of the band values add up to the variance of ``x`` when the bands tile
+    0 ... fs/2 (Parseval; bin ``k`` at ``k fs / n`` belongs to the band with
+    ``lo <= f < hi``, the last band includes the Nyquist bin).  ``order`` 1 gives the RMS
+    of the time derivative of ``x`` per band (each bin weighted by ``(2 pi f)^2``).
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+    fs : float
+        Sample rate [Hz].
+    bands : sequence of (float, float or None)
+        Band edges [Hz]; None as upper edge: fs/2.
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(bands),)
+    """
+    x = np.asarray(x, dtype=float)
+    n = x.size
+    if n < 2:
+        raise EroadInputError("band_rms: fewer than 2 samples")
+    X = np.fft.rfft(x - x.mean())
+    p = np.abs(X) ** 2 / n ** 2
+    p[1:] *= 2.0
+    if n % 2 == 0:
+        p[-1] /= 2.0  # the Nyquist bin is not doubled
+    f = np.fft.rfftfreq(n, 1.0 / fs)
+    p = p * (2 * math.pi * f) ** (2 * int(order))
+    out = np.zeros(len(bands))
+    for i, (lo, hi) in enumerate(bands):
+        top = np.inf if hi is None else hi
+        out[i] = math.sqrt(float(np.sum(p[(f >= lo) & (f < top)])))
+    return out
+
+
+def contact_case(case: dict) -> dict:
+    """One configuration: drive, base motion, pantograph-contact run and statistics.
+
+    Parameters
+    ----------
+    case : dict
+        From :func:`study_cases`.
+
+    Returns
+    -------
+    dict
+        Scalars: the contact statistics (``mean``, ``sd``, ``stat_min``, ``stat_max``,
+        ``actual_min``, ``actual_max``, ``loss_percent``, ``n_samples`` [N, %]),
+        ``unfiltered_min`` [N], the lateral statistics [m, %], ``base_z_rms`` [m],
+        ``frame_torsion_hz``, ``frame_bending_hz``, ``dcdc_bounce_hz`` (NaN if absent),
+        ``duration_s``, ``n_spans``, ``n_dof``, ``wall_vehicle_s``, ``wall_contact_s``;
+        arrays ``time`` [s], ``force`` [N] (unfiltered, every contact step) and
+        ``base_z`` [m] (on the same grid).
+    """
+    from studies.chassis_study import build_road
+    from studies.figure11 import mode_table, tractor_variant
+    from studies.pantograph_contact import contact_drive
+
+    road = build_road(case["road"])
+    rigid = case["frame"] == "rigid"
+    chassis = "rigid" if rigid else "flexible"
+    ff = 1.0 if rigid else float(case["frame"])
+    out = contact_drive(road, speed_kmh=float(case["speed_kmh"]),
+                        duration=float(case["duration"]), line=case["line"],
+                        pantograph=case["pantograph"], chassis=chassis, frame_factor=ff,
+                        mount_factor=float(case["mount"]), dt=float(case["dt"]),
+                        t_skip=float(case["t_skip"]), compare_static=False,
+                        base_scale=float(case["base_scale"]))
+    res = out["result"]
+    modes, _ = mode_table(tractor_variant(case["vehicle"], float(case["mount"])), chassis, ff,
+                          f_max=80.0)
+
+    def first(label):
+        for m in modes:
+            if m["label"] == label or m["label"].startswith(label + " "):
+                return float(m["freq_hz"])
+        return float("nan")
+
+    sel = res.time >= T_START - 1e-12
+    return {**{k: v for k, v in out["stats"].items() if k != "lowpass_hz"},
+            "unfiltered_min": float(np.min(res["force"][sel])),
+            **{f"lateral_{k}": v for k, v in out["lateral"].items()},
+            "base_z_rms": float(out["config"]["base_z_rms_m"]),
+            "frame_torsion_hz": first("frame torsion"),
+            "frame_bending_hz": first("frame bending"),
+            "dcdc_bounce_hz": first("DCDC bounce"),
+            "duration_s": float(out["config"]["duration_s"]),
+            "n_spans": int(out["config"]["n_spans"]), "n_dof": int(out["config"]["n_dof"]),
+            "wall_vehicle_s": float(out["wall"]["vehicle_s"]),
+            "wall_contact_s": float(out["wall"]["contact_s"]),
+            "time": np.asarray(res.time, dtype=float),
+            "force": np.asarray(res["force"], dtype=float),
+            "base_z": np.asarray(res["base_z"], dtype=float)}
+
+
+def collect(cases: list[dict], results: list[dict], lowpass_hz: float = 20.0):
+    """The study table and the arrays behind it.
+
+    The still-base case (``base_scale`` 0) gives ``F0``; each configuration's
+    base-induced force is ``dF = F - F0`` on the common time grid, its sd after the same
+    20 Hz low-pass as the statistics (``base_induced_sd_N``) and its unfiltered RMS per
+    :data:`FORCE_BANDS` band; the base velocity ``d(base_z)/dt`` per band likewise.  All
+    over ``t >= T_START``.
+
+    ``inertia_scale_N`` is the pantograph's total vertical mass times the RMS base
+    acceleration below 20 Hz: the scale of the inertial coupling of the base
+    acceleration into an articulated frame, which the lumped chain (base coupled through
+    ``k3, c3`` only) leaves out; an overestimate, since only part of the frame mass
+    follows the base.
+
+    Returns
+    -------
+    (pandas.DataFrame, dict)
+        The table (:data:`TABLE_COLUMNS`; configurations in case order, the still base
+        last) and arrays ``time``, ``force`` (n_rows, n), ``base_z`` (n_rows, n).
+    """
+    import pandas as pd
+
+    from catenary.stats import lowpass
+    from vehicles.pantograph_model import load_pantograph
+
+    still = [i for i, c in enumerate(cases) if float(c["base_scale"]) == 0.0]
+    if len(still) != 1:
+        raise EroadInputError("the study needs exactly one case with the base still")
+    r0 = results[still[0]]
+    t = np.asarray(r0["time"])
+    fs = 1.0 / float(t[1] - t[0])
+    sel = t >= T_START - 1e-12
+    f0 = np.asarray(r0["force"])
+    f0_lp = lowpass(f0, fs, lowpass_hz)
+    rows, forces, bases = [], [], []
+    order = [i for i in range(len(cases)) if i != still[0]] + still
+    for i in order:
+        c, r = cases[i], results[i]
+        ti = np.asarray(r["time"])
+        if ti.shape != t.shape or np.max(np.abs(ti - t)) > 1e-9:
+            raise EroadInputError(f"case {i}: time grid differs from the still-base case")
+        f = np.asarray(r["force"])
+        zb = np.asarray(r["base_z"])
+        is_still = i == still[0]
+        dF = f - f0
+        vz = np.gradient(zb, t)
+        pp = load_pantograph(c["pantograph"])
+        m_total = pp.head_mass + pp.upper_mass + pp.lower_mass
+        a_lo = float(band_rms(vz[sel], fs, ((0.0, 20.0),), order=1)[0])
+        d_band = band_rms(dF[sel], fs)
+        v_band = band_rms(vz[sel], fs)
+        row = {"base": "still" if is_still else "drive",
+               "frame": "-" if is_still else str(c["frame"]),
+               "mount": float("nan") if is_still else float(c["mount"]),
+               "frame_torsion_hz": float("nan") if is_still else r["frame_torsion_hz"],
+               "frame_bending_hz": float("nan") if is_still else r["frame_bending_hz"],
+               "dcdc_bounce_hz": float("nan") if is_still else r["dcdc_bounce_hz"],
+               "base_z_rms_mm": 1e3 * r["base_z_rms"],
+               "base_vz_rms_mm_s": 1e3 * float(np.std(vz[sel])),
+               "mean_N": r["mean"], "sd_N": r["sd"], "fm_minus_3sd_N": r["stat_min"],
+               "fm_plus_3sd_N": r["stat_max"], "min_N": r["actual_min"],
+               "max_N": r["actual_max"], "unfiltered_min_N": r["unfiltered_min"],
+               "loss_percent": r["loss_percent"],
+               "base_induced_sd_N": float(np.std((lowpass(f, fs, lowpass_hz) - f0_lp)[sel])),
+               "base_az_rms_0_20Hz_m_s2": a_lo, "inertia_scale_N": m_total * a_lo}
+        for b, dv, vv in zip(FORCE_BANDS, d_band, v_band):
+            row[f"dF_rms_{_band_label(b)}Hz_N"] = float(dv)
+            row[f"vz_rms_{_band_label(b)}Hz_mm_s"] = 1e3 * float(vv)
+        row.update({"lateral_max_mm": 1e3 * r["lateral_max_abs_offset"],
+                    "lateral_rms_mm": 1e3 * r["lateral_rms_offset"],
+                    "head_half_width_mm": 1e3 * r["lateral_half_width"],
+                    "lateral_margin_mm": 1e3 * r["lateral_margin"],
+                    "lateral_beyond_percent": r["lateral_beyond_percent"],
+                    "duration_s": r["duration_s"], "contact_wall_s": r["wall_contact_s"]})
+        rows.append(row)
+        forces.append(f)
+        bases.append(zb)
+    table = pd.DataFrame(rows, columns=list(TABLE_COLUMNS))
+    return table, {"time": t, "force": np.array(forces), "base_z": np.array(bases)}
+
+
+def _f(v, fmt="{:.1f}") -> str:
+    return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else fmt.format(v)
+
+
+def table_markdown(table) -> str:
+    """Two markdown tables: the contact-force quality per configuration and the
+    base-induced force per band with the base velocity per band."""
+    bl = [_band_label(b) for b in FORCE_BANDS]
+    lines = ["| frame | mount | Fm [N] | sd [N] | Fm-3sd [N] | min [N] | max [N] | "
+             "loss [%] | base-induced sd [N] | lateral max / half-width [mm] |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for _, r in table.iterrows():
+        fr = "base still" if r["base"] == "still" else r["frame"]
+        mo = "-" if r["base"] == "still" else f"{r['mount']:g}"
+        lines.append(f"| {fr} | {mo} | {_f(r['mean_N'])} | {_f(r['sd_N'], '{:.2f}')} | "
+                     f"{_f(r['fm_minus_3sd_N'])} | {_f(r['min_N'])} | {_f(r['max_N'])} | "
+                     f"{_f(r['loss_percent'], '{:.2f}')} | "
+                     f"{_f(r['base_induced_sd_N'], '{:.2f}')} | "
+                     f"{_f(r['lateral_max_mm'])} / {_f(r['head_half_width_mm'], '{:.0f}')} |")
+    lines += ["", "Base-induced contact force dF = F(drive) - F(base still), unfiltered RMS "
+              "per band [N], and base vertical velocity RMS per band [mm/s]:", "",
+              "| frame | mount | " + " | ".join(f"dF {b} Hz" for b in bl) + " | "
+              + " | ".join(f"vz {b} Hz" for b in bl) + " |",
+              "|---|---|" + "---|" * (2 * len(bl))]
+    for _, r in table[table["base"] == "drive"].iterrows():
+        lines.append(f"| {r['frame']} | {r['mount']:g} | "
+                     + " | ".join(_f(r[f"dF_rms_{b}Hz_N"], "{:.2f}") for b in bl) + " | "
+                     + " | ".join(_f(r[f"vz_rms_{b}Hz_mm_s"], "{:.1f}") for b in bl) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _frame_x(frames: list[str]) -> tuple[dict, list[float], list[str]]:
+    """x positions of the frame factors on a log axis (rigid: one factor 4 beyond the
+    stiffest flexible frame)."""
+    flex = sorted({float(f) for f in frames if f != "rigid"})
+    pos = {str(f): f for f in flex}
+    for f in frames:
+        if f != "rigid":
+            pos[f] = float(f)
+    if "rigid" in frames:
+        pos["rigid"] = (flex[-1] if flex else 1.0) * 4.0
+    ticks = flex + ([pos["rigid"]] if "rigid" in frames else [])
+    labels = [f"{f:g}" for f in flex] + (["rigid"] if "rigid" in frames else [])
+    return pos, ticks, labels
+
+
+def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: str = ""
+                            ) -> list[Path]:
+    """The study figure from the saved table (``table.csv``): contact-force sd, contact
+    loss (with the lowest unfiltered force), base-induced sd and its bands, against the
+    frame stiffness factor, one line per DCDC mount factor; writes PNG and PDF."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    df = pd.read_csv(table_csv, dtype={"frame": str})
+    drive = df[df["base"] == "drive"].copy()
+    still = df[df["base"] == "still"]
+    frames = list(dict.fromkeys(drive["frame"]))
+    pos, ticks, tlabels = _frame_x(frames)
+    drive["x"] = [pos[f] for f in drive["frame"]]
+    mounts = sorted(drive["mount"].unique())
+    cmap = plt.get_cmap("viridis")
+    colors = {m: cmap(0.15 + 0.7 * k / max(1, len(mounts) - 1)) for k, m in enumerate(mounts)}
+
+    fig, ax = plt.subplots(2, 2, figsize=(12, 8.5))
+
+    def frame_axis(a):
+        a.set_xscale("log")
+        a.set_xticks(ticks)
+        a.set_xticklabels(tlabels)
+        a.minorticks_off()
+        a.set_xlabel("frame stiffness factor [-]")
+        a.grid(True, alpha=0.3)
+
+    for m in mounts:
+        g = drive[drive["mount"] == m].sort_values("x")
+        flex = g[g["frame"] != "rigid"]
+        rig = g[g["frame"] == "rigid"]
+        kw = dict(color=colors[m], lw=1.3)
+        for a, col in ((ax[0, 0], "sd_N"), (ax[0, 1], "loss_percent"),
+                       (ax[1, 0], "base_induced_sd_N")):
+            a.plot(flex["x"], flex[col], "o-", label=f"DCDC mounts x{m:g}", **kw)
+            a.plot(rig["x"], rig[col], "*", ms=11, **kw)
+    if len(still):
+        s0 = float(still["sd_N"].iloc[0])
+        ax[0, 0].axhline(s0, color="k", ls="--", lw=1.0, label=f"base still: {s0:.2f} N")
+    ax[0, 0].set_ylabel("contact-force sd [N] (20 Hz low-pass)")
+    ax[0, 0].set_title("(a) contact-force standard deviation", fontsize=10)
+    ax[0, 0].legend(fontsize=8)
+    ax[0, 1].set_ylabel("contact loss [% of time]")
+    lo = float(np.nanmin(drive["unfiltered_min_N"]))
+    mean = float(np.nanmean(drive["mean_N"]))
+    ax[0, 1].set_title(f"(b) contact loss (lowest unfiltered force {lo:.1f} N, "
+                       f"mean {mean:.1f} N)", fontsize=10)
+    if float(np.nanmax(drive["loss_percent"])) == 0.0:
+        ax[0, 1].set_ylim(-0.5, 5.0)
+        ax[0, 1].text(0.5, 0.9, "no contact loss in any configuration", ha="center",
+                      transform=ax[0, 1].transAxes, fontsize=10)
+    tw = ax[0, 1].twinx()
+    for m in mounts:
+        g = drive[drive["mount"] == m].sort_values("x")
+        tw.plot(g["x"], g["unfiltered_min_N"], "s--", color=colors[m], ms=4, lw=0.9)
+    if len(still):
+        tw.axhline(float(still["unfiltered_min_N"].iloc[0]), color="k", ls=":", lw=1.0)
+    tw.set_ylabel("lowest unfiltered contact force [N] (squares, dashed;\n"
+                  "dotted: base still)", fontsize=8)
+    ax[1, 0].set_ylabel("sd of F(drive) - F(base still) [N] (20 Hz)")
+    ax[1, 0].set_title("(c) part of the force the base excitation causes", fontsize=10)
+    for a in (ax[0, 0], ax[0, 1], ax[1, 0]):
+        frame_axis(a)
+
+    # (d) base-induced force per band, nominal mounts, stacked as mean squares
+    m_nom = min(mounts, key=lambda m: abs(m - 1.0))
+    g = drive[drive["mount"] == m_nom].sort_values("x")
+    bl = [_band_label(b) for b in FORCE_BANDS]
+    xs = np.arange(len(g))
+    bottom = np.zeros(len(g))
+    bcols = plt.get_cmap("tab10")
+    for k, b in enumerate(bl):
+        v = g[f"dF_rms_{b}Hz_N"].to_numpy() ** 2
+        ax[1, 1].bar(xs, v, bottom=bottom, color=bcols(k), label=f"{b} Hz")
+        bottom += v
+    ax[1, 1].set_xticks(xs)
+    ax[1, 1].set_xticklabels([("rigid" if f == "rigid" else f"{float(f):g}") for f in g["frame"]])
+    ax[1, 1].set_xlabel(f"frame stiffness factor [-] (DCDC mounts x{m_nom:g})")
+    ax[1, 1].set_ylabel("mean square of F(drive) - F(base still) [N²], unfiltered")
+    ax[1, 1].set_title("(d) base-induced force by frequency band", fontsize=10)
+    ax[1, 1].set_ylim(0, 1.35 * float(bottom.max()) if bottom.max() > 0 else 1.0)
+    ax[1, 1].legend(fontsize=8, title="band", title_fontsize=8, ncol=len(bl),
+                    loc="upper center")
+    ax[1, 1].grid(True, axis="y", alpha=0.3)
+    fig.suptitle(title or "Contact-force quality against frame and DCDC-mount stiffness",
+                 fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, 0.96))
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(p, dpi=110)
+    fig.savefig(p.with_suffix(".pdf"))
+    plt.close(fig)
+    return [p, p.with_suffix(".pdf")]
+
+
+def _summary(table, cases, sweep, road_label: str) -> dict:
+    drive = table[table["base"] == "drive"]
+    still = table[table["base"] == "still"].iloc[0]
+    c0 = cases[0]
+
+    def pick(idx):
+        r = table.loc[idx]
+        return {"frame": r["frame"], "mount": float(r["mount"]), "sd_N": float(r["sd_N"]),
+                "base_induced_sd_N": float(r["base_induced_sd_N"])}
+
+    bl = [_band_label(b) for b in FORCE_BANDS]
+    band_ms = {b: float(np.mean(drive[f"dF_rms_{b}Hz_N"] ** 2)) for b in bl}
+    tot = sum(band_ms.values())
+    return {
+        "study": STUDY, "road": road_label, "speed_kmh": float(c0["speed_kmh"]),
+        "line": c0["line"], "pantograph": c0["pantograph"], "dt_s": float(c0["dt"]),
+        "n_configurations": int(len(drive)), "duration_s": float(still["duration_s"]),
+        "base_still": {k: float(still[k]) for k in ("mean_N", "sd_N", "fm_minus_3sd_N",
+                                                      "min_N", "max_N", "loss_percent")},
+        "sd_N_range": [float(drive["sd_N"].min()), float(drive["sd_N"].max())],
+        "base_induced_sd_N_range": [float(drive["base_induced_sd_N"].min()),
+                                    float(drive["base_induced_sd_N"].max())],
+        "lowest_sd": pick(drive["sd_N"].idxmin()), "highest_sd": pick(drive["sd_N"].idxmax()),
+        "max_loss_percent": float(drive["loss_percent"].max()),
+        "lowest_unfiltered_force_N": float(drive["unfiltered_min_N"].min()),
+        "max_lateral_offset_mm": float(drive["lateral_max_mm"].max()),
+        "head_half_width_mm": float(drive["head_half_width_mm"].iloc[0]),
+        "base_induced_band_share": {b: (v / tot if tot > 0 else float("nan"))
+                                    for b, v in band_ms.items()},
+        # base-induced force per unit base velocity, per band [N s/m] (median over the
+        # configurations): the damper c3 between base and lower frame if the chain is
+        # driven through it alone
+        "dF_over_vz_N_s_per_m": {b: float(np.median(drive[f"dF_rms_{b}Hz_N"]
+                                                    / (1e-3 * drive[f"vz_rms_{b}Hz_mm_s"])))
+                                 for b in bl},
+        "inertia_scale_N_range": [float(drive["inertia_scale_N"].min()),
+                                  float(drive["inertia_scale_N"].max())],
+        "n_cases": len(sweep.cases), "n_computed": sweep.n_computed,
+        "n_cached": sweep.n_cached, "sweep_wall_s": round(sweep.wall_s, 2),
+        "case_wall_s_sum": round(float(sum(w for w in sweep.case_wall_s if w)), 2)}
+
+
+def _write_outputs(folder: Path, table, arrays, title: str) -> list[Path]:
+    data = folder / "data"
+    figs = folder / "figures"
+    data.mkdir(parents=True, exist_ok=True)
+    figs.mkdir(parents=True, exist_ok=True)
+    table.to_csv(data / "table.csv", index=False, float_format="%.6g")
+    (data / "table.md").write_text(table_markdown(table), encoding="utf-8")
+    np.savez_compressed(data / "forces.npz", time=arrays["time"].astype(np.float32),
+                        force=arrays["force"].astype(np.float32),
+                        base_z=arrays["base_z"].astype(np.float32),
+                        frame=np.array(table["frame"], dtype=str),
+                        mount=table["mount"].to_numpy(float),
+                        base=np.array(table["base"], dtype=str))
+    return plot_pantograph_chassis(data / "table.csv", figs / "contact_vs_stiffness.png",
+                                   title=title)
+
+
+def run_pantograph_chassis(road_path: str | Path, out_root: str | Path = "results", *,
+                           run_dir: str | Path | None = None, frames=FRAME_FACTORS,
+                           mounts=MOUNT_FACTORS, speed_kmh: float = 80.0,
+                           duration: float = 30.0, line: str = "truck_ohl",
+                           pantograph: str = "truck", dt: float = 1e-3, scheduler: Any = None,
+                           n_workers: int = 2, cache_dir: str | Path = ".eroad-cache",
+                           progress: bool = True, command: list[str] | None = None) -> dict:
+    """Run the study on a road and archive it.
+
+    Parameters
+    ----------
+    road_path : str or Path
+        Road file.
+    out_root : str or Path
+        Results root: the run goes to ``<out_root>/pantograph_chassis/<run-id>/``
+        (:class:`eroad.archive.RunArchive`) unless ``run_dir`` is given.
+    run_dir : str or Path, optional
+        A named run folder instead (must not exist or be empty; written as a hidden
+        temporary folder and renamed into place, ``run.json`` by
+        :func:`eroad.archive.run_info`).
+    frames, mounts, speed_kmh, duration, line, pantograph, dt
+        See :func:`study_cases`.
+    scheduler, n_workers, cache_dir, progress
+        Passed to :func:`studies.sweep.run_cases` (processes; ``n_workers`` 0/1: serial).
+    command : list of str, optional
+        Command line for ``run.json``.
+
+    Returns
+    -------
+    dict
+        The summary (also ``summary.json``) with ``path``.
+    """
+    from catenary.line import load_line
+    from eroad.archive import (RunArchive, finish_run_info, run_info, write_json_atomic,
+                               write_run_json)
+    from studies.chassis_study import road_specs
+    from studies.sweep import run_cases
+    from vehicles.pantograph_model import load_pantograph
+
+    load_line(line)  # refuse bad ids before anything runs
+    load_pantograph(pantograph)
+    p = Path(road_path)
+    if not p.is_file():
+        raise EroadInputError(f"road file not found: {road_path}")
+    specs, _ = road_specs(p, n_seeds=0)
+    cases = study_cases(specs[0], frames=frames, mounts=mounts, speed_kmh=speed_kmh,
+                        duration=duration, line=line, pantograph=pantograph, dt=dt)
+    config = {"road_file": str(p), "road_sha256": specs[0]["sha256"],
+              "frames": [_frame_value(f) for f in frames],
+              "mounts": [float(m) for m in mounts], "speed_kmh": float(speed_kmh),
+              "duration_s": float(duration), "line": line, "pantograph": pantograph,
+              "dt_s": float(dt), "t_start_s": T_START, "lowpass_hz": 20.0,
+              "force_bands_hz": [[lo, -1.0 if hi is None else hi] for lo, hi in FORCE_BANDS],
+              "n_cases": len(cases), "case_function": "studies.pantograph_chassis:contact_case"}
+    version = code_version()
+    title = (f"Pantograph contact force vs frame and DCDC-mount stiffness: {p.name}, "
+             f"{speed_kmh:g} km/h, line {line}, pantograph {pantograph}")
+
+    def compute(folder: Path) -> dict:
+        sweep = run_cases(contact_case, cases, cache_dir=cache_dir, scheduler=scheduler,
+                          n_workers=n_workers, progress=progress, code_version=version,
+                          desc="pantograph chassis")
+        table, arrays = collect(sweep.cases, sweep.results)
+        figs = _write_outputs(folder, table, arrays, title)
+        summary = _summary(table, cases, sweep, str(p))
+        summary["code_version"] = version
+        summary["figures"] = [str(f.relative_to(folder)) for f in figs]
+        summary["table"] = "data/table.csv"
+        return summary
+
+    if run_dir is None:
+        with RunArchive(STUDY, config, root=out_root, command=command) as run:
+            summary = compute(run.path)
+            run.write_summary(summary)
+        summary["path"] = str(run.path)
+        return summary
+
+    import tomli_w
+
+    out = Path(run_dir)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        raise EroadInputError(f"{out}: exists and is not empty; choose another --run-dir")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f".{out.name}.tmp-{os.getpid()}")
+    if tmp.exists():
+        shutil.rmtree(tmp)
+    tmp.mkdir()
+    record = run_info(STUDY, run_id=out.name, command=command)
+    t0 = _time.perf_counter()
+    (tmp / "config.toml").write_text(tomli_w.dumps(config), encoding="utf-8")
+    try:
+        summary = compute(tmp)
+        finish_run_info(record, "complete", wall_s=_time.perf_counter() - t0)
+    except BaseException as exc:
+        finish_run_info(record, "failed", wall_s=_time.perf_counter() - t0, error=exc)
+        write_run_json(tmp, record)
+        tmp.rename(out.with_name(f"{out.name}.failed-{os.getpid()}"))
+        raise
+    write_run_json(tmp, record)
+    write_json_atomic(tmp / "summary.json", summary)
+    if out.exists():
+        out.rmdir()
+    tmp.rename(out)
+    summary["path"] = str(out)
+    return summary

@@ -1,0 +1,117 @@
+"""Chassis-stiffness study in contact-force terms (studies.pantograph_chassis).
+
+A tiny study (frame factors 0.25 and rigid, nominal mounts, a 4 s drive at 80 km/h on
+the identified road of the committed reference run, serial) checks the table's columns,
+the run folder and these physical properties, each of which can fail:
+
+* the base excitation adds to the contact-force sd: sd(drive) > sd(base still), and the
+  base-induced part ``F(drive) - F(base still)`` is not zero (it is zero for the still
+  row by construction);
+* the truck line has linear droppers and the contact does not open, so the contact
+  problem is linear in the base motion: doubling the base motion doubles the
+  base-induced force (tolerance 1e-6 relative: round-off of ~3000 HHT steps, each a
+  banded solve, is ~1e-12; 1e-6 also leaves room for the float64 sums);
+* below the pantograph's modes the base acts through the lower damper c3 (70 N s/m): the
+  base-induced force per unit base velocity in 0.5-5 Hz lies between 0.5 c3 and 1.0 c3
+  (the lower frame moves a little with the base, so less than c3; far more than the
+  base spring k3 = 0.1 N/m could give).
+"""
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from eroad.cli import main
+from studies.pantograph_chassis import (FORCE_BANDS, TABLE_COLUMNS, band_rms, contact_case,
+                                        run_pantograph_chassis, study_cases)
+
+ROAD = Path(__file__).resolve().parents[1] / "results" / "reproduce" / \
+    "20261124-luliang-seed0" / "invert" / "road.npz"
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    if not ROAD.is_file():
+        pytest.skip("reference road not in this checkout")
+    out = tmp_path_factory.mktemp("pc")
+    s = run_pantograph_chassis(ROAD, out, run_dir=out / "run", frames=(0.25, "rigid"),
+                               mounts=(1.0,), duration=4.0, n_workers=0,
+                               cache_dir=out / "cache", progress=False, command=["test"])
+    return s, pd.read_csv(out / "run" / "data" / "table.csv", dtype={"frame": str})
+
+
+def test_table_columns_and_run_folder(tiny):
+    s, t = tiny
+    run = Path(s["path"])
+    assert list(t.columns) == list(TABLE_COLUMNS)
+    assert list(t["base"]) == ["drive", "drive", "still"]
+    assert list(t["frame"]) == ["0.25", "rigid", "-"]
+    md = (run / "data" / "table.md").read_text()
+    assert md.count("| 0.25 | 1 |") == 2 and "| base still |" in md
+    for name in ("run.json", "summary.json", "config.toml", "figures/contact_vs_stiffness.png",
+                 "data/forces.npz"):
+        assert (run / name).is_file(), name
+    info = json.loads((run / "run.json").read_text())
+    assert info["status"] == "complete" and info["run_id"] == "run"
+    assert s["n_configurations"] == 2
+
+
+def test_base_excitation_adds_to_the_sd(tiny):
+    _, t = tiny
+    still = t[t["base"] == "still"].iloc[0]
+    drive = t[t["base"] == "drive"]
+    assert still["base_induced_sd_N"] == 0.0
+    assert (drive["base_induced_sd_N"] > 0.05).all()
+    assert (drive["sd_N"] > still["sd_N"]).all()
+    # no loss, mean = static force (70 N) within 1 % (momentum balance, see
+    # tests/test_pantograph_contact.py)
+    assert (t["loss_percent"] == 0).all()
+    assert np.allclose(t["mean_N"], 70.0, rtol=0.01)
+    # the lateral offset stays on the head
+    assert (drive["lateral_max_mm"] < drive["head_half_width_mm"]).all()
+
+
+def test_base_acts_through_the_lower_damper(tiny):
+    _, t = tiny
+    drive = t[t["base"] == "drive"]
+    ratio = drive["dF_rms_0.5-5Hz_N"] / (1e-3 * drive["vz_rms_0.5-5Hz_mm_s"])
+    assert ((ratio > 0.5 * 70.0) & (ratio < 70.0)).all(), ratio.tolist()
+
+
+def test_contact_force_linear_in_base_motion():
+    if not ROAD.is_file():
+        pytest.skip("reference road not in this checkout")
+    from studies.chassis_study import road_specs
+
+    spec = road_specs(ROAD, n_seeds=0)[0][0]
+    case = study_cases(spec, frames=(1.0,), mounts=(1.0,), duration=4.0)[0]
+    f = {k: contact_case({**case, "base_scale": k})["force"] for k in (0.0, 1.0, 2.0)}
+    assert f[1.0].min() > 0 and f[2.0].min() > 0  # the contact never opens
+    d1, d2 = f[1.0] - f[0.0], f[2.0] - f[0.0]
+    assert np.max(np.abs(d1)) > 0.1
+    assert np.max(np.abs(d2 - 2 * d1)) < 1e-6 * np.max(np.abs(d2))
+
+
+def test_band_rms_parseval_and_derivative():
+    fs, n = 1000.0, 4000
+    t = np.arange(n) / fs
+    rng = np.random.default_rng(1)
+    x = 0.3 * np.sin(2 * math.pi * 3.0 * t) + 0.1 * rng.standard_normal(n)
+    b = band_rms(x, fs)
+    assert np.sum(b ** 2) == pytest.approx(np.var(x), rel=1e-12)
+    s = 0.3 * np.sin(2 * math.pi * 3.0 * t)  # whole periods: one bin at 3 Hz
+    bs = band_rms(s, fs)
+    assert bs[1] == pytest.approx(0.3 / math.sqrt(2), rel=1e-9)
+    assert np.sum(bs ** 2) - bs[1] ** 2 < 1e-20
+    d = band_rms(s, fs, order=1)
+    assert d[1] == pytest.approx(2 * math.pi * 3.0 * 0.3 / math.sqrt(2), rel=1e-9)
+    assert len(b) == len(FORCE_BANDS)
+
+
+def test_cli_grid_needs_a_road(capsys, tmp_path):
+    rc = main(["pantograph-contact", "--out", str(tmp_path), "--chassis-grid"])
+    err = capsys.readouterr().err
+    assert rc != 0 and "--road" in err and "Traceback" not in err
