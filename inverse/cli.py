@@ -2,6 +2,9 @@
 
 This module only parses the options and prints; the run itself is
 :func:`inverse.run.run_inversion` (the run folder it writes is described there).
+Several datasets (``eroad invert DIR1 DIR2 ... --out ROOT``), or one with
+``--scheduler ADDRESS``, run on Dask, one run folder each under ROOT
+(:func:`inverse.batch.invert_many`), one line printed per drive.
 A progress bar goes to stderr when stderr is a terminal (not with ``--json`` or
 ``--quiet``).
 """
@@ -27,10 +30,16 @@ def register(subparsers) -> None:
         description="Segment a measured drive, fit the ISO 8608 parameters of each segment with the "
                     "nominal Exudyn truck (sampled sensitivities, common random numbers), select the "
                     "road realisation, and write Tables 1-2, Figures 6/8/9 and the global road.")
-    p.add_argument("dataset", help="dataset folder (drives format)")
-    p.add_argument("--out", required=True, help="run folder to create")
+    p.add_argument("dataset", nargs="+",
+                   help="dataset folder (drives format); several: each inverted into OUT/<folder name> on Dask")
+    p.add_argument("--out", required=True,
+                   help="run folder to create (several datasets or --scheduler: the folder of the run folders)")
+    p.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="run the drives on an existing Dask scheduler (tcp://host:8786); default with several "
+                        "datasets: a local cluster of --workers processes, each drive serial in one")
     p.add_argument("--segments", type=int, default=None, help="number of segments K (default: BIC criterion)")
-    p.add_argument("--workers", type=int, default=2, help="processes for the simulations (default 2)")
+    p.add_argument("--workers", type=int, default=2,
+                   help="processes for the simulations (default 2); several datasets: local Dask workers")
     p.add_argument("--seed", type=int, default=0, help="root seed of the fit and candidate phases")
     p.add_argument("--candidates", type=int, default=None,
                    help="phase realisations tried in the selection (default 16, 6 with --quick; 0: keep the fit's)")
@@ -52,6 +61,10 @@ def register(subparsers) -> None:
     p.add_argument("--fit", choices=("simulation", "linear"), default="simulation",
                    help="fit model: 'simulation' (every evaluation a time simulation; default) or 'linear' "
                         "(linear-model features corrected by a few time simulations, docs/inverse.md section 12)")
+    p.add_argument("--selection", choices=("linear", "simulation"), default="linear",
+                   help="how the candidate road realisations are scored: 'linear' (the linear truck's time "
+                        "response corrected by the simulated ones; the fit's and the best candidates "
+                        "simulated; default) or 'simulation' (every candidate simulated), docs/inverse.md section 12")
     p.add_argument("--road-model", choices=("auto", "one"), default="auto",
                    help="road spectrum per segment: 'auto' (one ISO slope or two, with a break frequency, "
                         "chosen by BIC; default) or 'one' (one slope everywhere); docs/road_model.md")
@@ -68,7 +81,10 @@ def _cmd_invert(args) -> int:
     common = dict(segments=args.segments, workers=args.workers, seed=args.seed, quick=args.quick,
                   force=args.force, candidates=args.candidates, max_iter=args.max_iter,
                   channels=args.channels, noise_sd=_noise(args.noise), argv=sys.argv, fit_model=args.fit,
-                  road_model=args.road_model)
+                  selection=args.selection, road_model=args.road_model)
+    if len(args.dataset) > 1 or args.scheduler is not None:
+        return _cmd_invert_many(args, common)
+    args.dataset = args.dataset[0]
     show = wants_progress(args)
     with progress_bar(show, desc="invert") as bar:
         if args.effects == "auto":
@@ -104,6 +120,41 @@ def _cmd_invert(args) -> int:
         if "closed_loop" in summary:
             print(f"closed loop: {summary['closed_loop']['reason']}")
     return 0
+
+
+def _cmd_invert_many(args, common) -> int:
+    """Several drives on Dask: one line per drive as it finishes, exit 1 if any failed."""
+    from inverse.batch import invert_many, silent
+
+    if args.json:
+        raise EroadInputError("--json prints one run's summary; with several datasets read OUT/batch.json "
+                              "and OUT/<name>/summary.json")
+    kw = {k: v for k, v in common.items() if k not in ("workers", "argv")}
+    if args.effects == "auto":
+        if args.effect:
+            raise EroadInputError("--effects auto and --effect NAME=VALUE cannot be combined")
+        runner = "diagnosis.closed_loop:invert_closed_loop"   # the closed loop sits above inverse
+        kw["progress"] = silent                               # its progress lines stay in the worker
+    else:
+        runner = "inverse.run:run_inversion"
+        kw["effects"] = _effects(args.effect)
+
+    def line(r):
+        if r["status"] == "complete":
+            e = r.get("rms_err", {})
+            errs = ", ".join(f"{c} RMS err {100 * v:+.1f}%" for c, v in e.items() if v is not None)
+            poor = "; POOR FIT" if r.get("fit_quality") == "poor" else ""
+            print(f"{r['dataset']}: wrote {r['run']}: classes {' '.join(r['classes'])}"
+                  + (f"; {errs}" if errs else "") + f"{poor} ({r['wall_s']:.1f} s)", flush=True)
+        else:
+            print(f"{r['dataset']}: FAILED: {r['error']}", flush=True)
+
+    res = invert_many(args.dataset, args.out, scheduler=args.scheduler, n_workers=args.workers, runner=runner,
+                      argv=sys.argv, report=line, **kw)
+    n_bad = sum(r["status"] != "complete" for r in res)
+    print(f"{len(res) - n_bad} of {len(res)} drives inverted into {args.out} ({args.out}/batch.json)"
+          + (f"; {n_bad} failed" if n_bad else ""))
+    return 1 if n_bad else 0
 
 
 def _noise(items) -> dict | None:

@@ -93,7 +93,8 @@ def check_out(out: Path, force: bool) -> None:
 def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 0, quick: bool = False,
                   force: bool = False, candidates=None, max_iter=None, effects=None, chassis: str = "rigid",
                   channels="axle3", argv=None, polish: bool = True, noise_sd=None,
-                  fit_model: str = "simulation", bar=None, road_model: str = "auto") -> dict:
+                  fit_model: str = "simulation", selection: str = "linear", bar=None,
+                  road_model: str = "auto") -> dict:
     """Invert a dataset into the run folder ``out`` (see the module docstring).
 
     Parameters
@@ -127,6 +128,12 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     fit_model : {"simulation", "linear"}
         The fit's model (:class:`inverse.pipeline.InversionConfig`); recorded in
         ``summary["fit"]["model"]`` and config.toml.
+    selection : {"linear", "simulation"}
+        How the candidate realisations are scored: "linear" (default) by the linear
+        truck's time response corrected by the simulated ones, only the fit's and the
+        most promising candidates simulated
+        (:func:`inverse.realisation.select_realisation_linear`); "simulation" every
+        candidate a time simulation (:func:`inverse.realisation.select_realisation`).
     polish : bool
         The fit's final polishing step over several road realisations
         (:class:`inverse.sensitivity.FitConfig` ``polish_replicates``); off only to
@@ -146,7 +153,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     """
     from drives.format import read_drive
     from inverse.pipeline import SEED_KEY_FIT, InversionConfig, invert, stream_seed
-    from inverse.realisation import candidate_seeds, select_realisation
+    from inverse.realisation import candidate_seeds, select_realisation, select_realisation_linear
     from inverse.report import (TABLE2_CHANNELS, TABLE2_NOTE, table1, table1_note, table2, write_figures,
                                 write_table)
     from inverse.uncertainty import overall_fit_quality
@@ -172,6 +179,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     iters = int(max_iter if max_iter is not None else (3 if quick else 12))
     if n_cand < 0 or iters < 1:
         raise EroadInputError("--candidates must be >= 0 (0: keep the fit's phases) and --max-iter >= 1")
+    if selection not in ("linear", "simulation"):
+        raise EroadInputError(f"--selection must be 'linear' or 'simulation', got {selection!r}")
 
     time = np.asarray(drive.time, float)
     chans = {c: drive.channels[c].to_numpy(float) for c in fit_channels(drive.channel_names, channels)}
@@ -189,7 +198,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     map_fn = map
     if workers > 1:
         from concurrent.futures import ProcessPoolExecutor
-        pool = ProcessPoolExecutor(workers)
+        pool = ProcessPoolExecutor(workers, initializer=_warm_worker)
+        pool.submit(int)       # start the workers now: their imports overlap the segmentation
         map_fn = pool.map
     timing = {}
     if bar is not None:
@@ -209,7 +219,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         table_ch = [c for c in TABLE2_CHANNELS if c in chans]
         sel_map = map_fn
         if bar is not None:
-            bar.reset(total=len(seeds))
+            # linear: the fit's simulation, every candidate's linear response, usually one round of 2
+            bar.reset(total=len(seeds) + (3 if selection == "linear" and n_cand else 0))
             bar.set_description("invert: road realisations")
 
             def sel_map(func, items):   # one step per finished candidate simulation
@@ -217,92 +228,117 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                     bar.update(1)
                     yield r
         # one seed for both tracks: a per-side choice by the reported RMS would tune Table 2 to itself
-        sel = select_realisation(sim, params, chans, seeds, table_channels=table_ch, map_fn=sel_map,
-                                 labels=labels, sides=False)
+        if selection == "linear" and n_cand > 0:
+            from inverse.linear_response import LinearRealisation
+
+            sel = select_realisation_linear(sim, LinearRealisation(sim), params, chans, seeds,
+                                            table_channels=table_ch, map_fn=sel_map, labels=labels,
+                                            per_round=max(1, workers))
+        else:
+            sel = select_realisation(sim, params, chans, seeds, table_channels=table_ch, map_fn=sel_map,
+                                     labels=labels, sides=False)
+            sel.update(method="simulation", n_simulated=len(seeds), fit_simulated=sel.pop("simulated_all")[0])
         timing["selection_s"] = _time.perf_counter() - t1
+        timing["selection_sims"] = int(sel["n_simulated"])
+        t1 = _time.perf_counter()
+        if bar is not None:
+            bar.set_description("invert: report")
+        from drives.format import swap_into_place, temp_folder_beside
+
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = temp_folder_beside(out)
+        (tmp / "tables").mkdir()
+        try:
+            # the figures in a worker while this process writes the rest (report.write_figures)
+            fig_kw = dict(time=time, measured=chans, simulated=sel["simulated"], segmentation=inv.segmentation,
+                          seg_signal=chans["susp_disp_3L"], title=f"({drive.name})")
+            figures = pool.submit(write_figures, tmp / "figures", **fig_kw) if pool is not None else None
+            simulated = sel["simulated"]
+            rows = response_table(chans, simulated, table_ch)
+            fit_rows = response_table(chans, sel["fit_simulated"], table_ch) if sel["label"] != "fit" else rows
+            segs = inv.segments()
+            # the road model of each segment, one ISO slope or two (inverse.road_model)
+            from inverse.road_model import add_road_models, select_road_models
+            add_road_models(segs, select_road_models(inv, sim, speed, road_model))
+            summary = {
+                "format": RUN_FORMAT,
+                "dataset": {"name": drive.name, "path": dataset_path(dataset, out), "vehicle": str(drive.vehicle),
+                            "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz,
+                            "warnings": list(drive.warnings)},
+                "segments": segs,
+                "fit_quality": overall_fit_quality(segs),
+                "table2": rows,
+                "errors": headline(rows, sel["spread"]),
+                "selection": {"n_candidates": len(seeds), "selected": sel["label"], "seed": sel["seed"],
+                              "statistic": "sum of w_c ln(rms_sim/rms_meas)^2 over axle_acc_3L/R (w 1) and "
+                                           "susp_disp_3L/R (w 0.25), plus ln(mean_abs ratio)^2 of axle_acc_3L/R",
+                              "method": sel["method"], "n_simulated": sel["n_simulated"],
+                              "rounds": sel.get("rounds"), "correction": sel.get("correction"),
+                              "per_side": bool(sel.get("sides")), "mismatch": sel["mismatch"],
+                              "sides_rejected": sel.get("sides_rejected"),
+                              "spread": sel["spread"],
+                              "candidates": sel["candidates"],
+                              "fit_phases_errors": headline(fit_rows)},
+                "fit": inv.summary()["fit"],
+                "segmentation": inv.summary()["segmentation"],
+                "road": {"file": "road.npz", "crg": "road.crg", "seed": sel["seed"], "dx": SIM_DX,
+                         "seg_lengths_m": [float(v) for v in sim.layout()["seg_lengths"]]},
+            }
+            from inverse.lateral import note_line, run_summary
+
+            summary["lateral"] = run_summary(drive.vehicle, segs, time, speed, list(chans),
+                                             effects=effects, chassis=chassis)
+            write_table(table1(segs), tmp / "tables" / "table1",
+                        note=table1_note(summary["fit_quality"]) + "\n\n" + note_line(summary["lateral"]))
+            write_table(table2(rows, sel["spread"]), tmp / "tables" / "table2", note=TABLE2_NOTE)
+            import pandas as pd
+            pd.DataFrame([{"label": c["label"], "seed": c["seed"], "mismatch": c["mismatch"],
+                           "basis": c.get("basis", "simulated"),
+                           **{f"rms_err_{k}": v for k, v in c["rms_err"].items()}} for c in sel["candidates"]]
+                         ).to_csv(tmp / "tables" / "candidates.csv", index=False)
+            road = sim.road(params, sel["seed"])
+            road.save(tmp / "road.npz")
+            road.save(tmp / "road.crg")
+            write_json_atomic(tmp / "history.json", inv.fit.history)
+            import tomli_w
+            cfg = {"dataset": dataset_path(dataset, out),
+                   "segments": segments if segments is not None else "auto",
+                   "noise_sd": dict(noise_sd or {}), "polish": bool(polish),
+                   "workers": workers, "seed": seed, "quick": quick, "candidates": n_cand, "max_iter": iters,
+                   "chassis": chassis, "channels": list(chans), "effects": json.dumps(effects or {}),
+                   "fit_model": fit_model, "selection": selection,
+                   "simulator": {"dx_m": SIM_DX, "nmax_cap_cpm": nmax_cap(SIM_DX)},
+                   "bounds": {k: list(getattr(bounds, k)) for k in ("Gq_n0", "w", "nmin", "nmax")}}
+            (tmp / "config.toml").write_text(tomli_w.dumps(cfg))
+            if figures is None:
+                write_figures(tmp / "figures", **fig_kw)
+            else:
+                figures.result()
+            timing["report_s"] = _time.perf_counter() - t1
+            timing["total_s"] = _time.perf_counter() - t0
+            timing["n_sims"] = int(inv.fit.n_sims + sel["n_simulated"])
+            timing["workers"] = workers
+            summary["timing"] = timing
+            summary["history"] = inv.fit.history
+            write_json_atomic(tmp / "summary.json", summary)
+            write_run_json(tmp, finish_run_info(record, "complete", wall_s=timing["total_s"]))
+            swap_into_place(tmp, out)   # an old RUN (--force) is removed only once the new one is in place
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
     finally:
         if pool is not None:
-            pool.shutdown()
-
-    t1 = _time.perf_counter()
-    if bar is not None:
-        bar.set_description("invert: report")
-    from drives.format import swap_into_place, temp_folder_beside
-
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = temp_folder_beside(out)
-    (tmp / "tables").mkdir()
-    try:
-        simulated = sel["simulated"]
-        rows = response_table(chans, simulated, table_ch)
-        fit_rows = response_table(chans, sim(params, fit_seed), table_ch) if sel["label"] != "fit" else rows
-        n_extra = (1 if sel["label"] != "fit" else 0) + (1 if sel.get("sides") or "sides_rejected" in sel else 0)
-        segs = inv.segments()
-        # the road model of each segment, one ISO slope or two (inverse.road_model)
-        from inverse.road_model import add_road_models, select_road_models
-        add_road_models(segs, select_road_models(inv, sim, speed, road_model))
-        summary = {
-            "format": RUN_FORMAT,
-            "dataset": {"name": drive.name, "path": dataset_path(dataset, out), "vehicle": str(drive.vehicle),
-                        "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz,
-                        "warnings": list(drive.warnings)},
-            "segments": segs,
-            "fit_quality": overall_fit_quality(segs),
-            "table2": rows,
-            "errors": headline(rows, sel["spread"]),
-            "selection": {"n_candidates": len(seeds), "selected": sel["label"], "seed": sel["seed"],
-                          "statistic": "sum of w_c ln(rms_sim/rms_meas)^2 over axle_acc_3L/R (w 1) and "
-                                       "susp_disp_3L/R (w 0.25), plus ln(mean_abs ratio)^2 of axle_acc_3L/R",
-                          "per_side": bool(sel.get("sides")), "mismatch": sel["mismatch"],
-                          "sides_rejected": sel.get("sides_rejected"),
-                          "spread": sel["spread"],
-                          "candidates": sel["candidates"],
-                          "fit_phases_errors": headline(fit_rows)},
-            "fit": inv.summary()["fit"],
-            "segmentation": inv.summary()["segmentation"],
-            "road": {"file": "road.npz", "crg": "road.crg", "seed": sel["seed"], "dx": SIM_DX,
-                     "seg_lengths_m": [float(v) for v in sim.layout()["seg_lengths"]]},
-        }
-        from inverse.lateral import note_line, run_summary
-
-        summary["lateral"] = run_summary(drive.vehicle, segs, time, speed, list(chans),
-                                         effects=effects, chassis=chassis)
-        write_table(table1(segs), tmp / "tables" / "table1",
-                    note=table1_note(summary["fit_quality"]) + "\n\n" + note_line(summary["lateral"]))
-        write_table(table2(rows, sel["spread"]), tmp / "tables" / "table2", note=TABLE2_NOTE)
-        import pandas as pd
-        pd.DataFrame([{"label": c["label"], "seed": c["seed"], "mismatch": c["mismatch"],
-                       **{f"rms_err_{k}": v for k, v in c["rms_err"].items()}} for c in sel["candidates"]]
-                     ).to_csv(tmp / "tables" / "candidates.csv", index=False)
-        seg_sig = chans["susp_disp_3L"]
-        write_figures(tmp / "figures", time=time, measured=chans, simulated=simulated,
-                      segmentation=inv.segmentation, seg_signal=seg_sig, title=f"({drive.name})")
-        road = sim.road(params, sel["seed"])
-        road.save(tmp / "road.npz")
-        road.save(tmp / "road.crg")
-        write_json_atomic(tmp / "history.json", inv.fit.history)
-        timing["report_s"] = _time.perf_counter() - t1
-        timing["total_s"] = _time.perf_counter() - t0
-        timing["n_sims"] = int(inv.fit.n_sims + len(seeds) + n_extra)
-        timing["workers"] = workers
-        summary["timing"] = timing
-        summary["history"] = inv.fit.history
-        write_json_atomic(tmp / "summary.json", summary)
-        import tomli_w
-        cfg = {"dataset": dataset_path(dataset, out), "segments": segments if segments is not None else "auto",
-               "noise_sd": dict(noise_sd or {}), "polish": bool(polish),
-               "workers": workers, "seed": seed, "quick": quick, "candidates": n_cand, "max_iter": iters,
-               "chassis": chassis, "channels": list(chans), "effects": json.dumps(effects or {}),
-               "fit_model": fit_model,
-               "simulator": {"dx_m": SIM_DX, "nmax_cap_cpm": nmax_cap(SIM_DX)},
-               "bounds": {k: list(getattr(bounds, k)) for k in ("Gq_n0", "w", "nmin", "nmax")}}
-        (tmp / "config.toml").write_text(tomli_w.dumps(cfg))
-        write_run_json(tmp, finish_run_info(record, "complete", wall_s=timing["total_s"]))
-        swap_into_place(tmp, out)   # an old RUN (--force) is removed only once the new one is in place
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+            pool.shutdown(cancel_futures=True)
     return summary
+
+
+def _warm_worker() -> None:
+    """Pool initializer: the imports a worker will need (the simulator, the figures)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot  # noqa: F401
+
+    import vehicles.simulate  # noqa: F401
 
 
 def dataset_path(dataset, run) -> str:
