@@ -32,7 +32,10 @@ def table1(segments: list) -> pd.DataFrame:
         present the best-determined level (n_best [cycles/m], G_n_best
         [1e-6 m^3], sd of ln G there) with the sd of ln Gq_n0 for comparison, the
         90 % intervals of Gq_n0 and w, and the fit-quality gate ('clean' / 'poor')
-        with the misfit per feature (:mod:`inverse.uncertainty`).
+        with the misfit per feature (:mod:`inverse.uncertainty`); where the run chose
+        a road model per segment (:mod:`inverse.road_model`): road_model
+        ('one_slope' / 'two_slope'), w_low, w_high, n_break [cycles/m] and
+        bic_gain_two_slope (ic_delta, > 0 chose two slopes).
     """
     rows = []
     for i, s in enumerate(segments):
@@ -50,12 +53,33 @@ def table1(segments: list) -> pd.DataFrame:
                          "w_90pct": "{:.2f}-{:.2f}".format(*s["interval90"]["w"])} if "interval90" in s else {}),
                      **({"fit": s["fit_quality"]["status"],
                          "misfit_per_feature": round(s["fit_quality"]["misfit_per_feature"], 2)}
-                        if "fit_quality" in s else {})})
+                        if "fit_quality" in s else {}),
+                     **(_road_model_columns(s) if "road_model" in s else {})})
     return pd.DataFrame(rows)
 
 
-def table1_note(fit_quality: dict | None = None) -> str:
-    """The paragraph under Table 1: what the uncertainty columns mean, and the gate's verdict."""
+def _road_model_columns(s: dict) -> dict:
+    """Table 1's road-model columns of one segment row (the old columns stay the one-slope fit)."""
+    nb, d = s.get("n_break"), s.get("ic_delta")
+    return {"road_model": s["road_model"], "w_low": round(s["w_low"], 3), "w_high": round(s["w_high"], 3),
+            "n_break_cpm": "" if nb is None else round(nb, 4),
+            "bic_gain_two_slope": "" if d is None else round(d, 2)}
+
+
+#: the note's sentence on the road-model columns (written when Table 1 has them)
+ROAD_MODEL_NOTE = (
+    "Gq_n0 and w are the one-slope ISO 8608 fit in every row. 'road_model' says whether the "
+    "segment's response features are explained better by two slopes, w_low below n_break and "
+    "w_high above (continuous at n_break), by enough to pay their two extra parameters: "
+    "bic_gain_two_slope = BIC(one) - BIC(two) on the fit's weighted residual, two slopes when > 0 "
+    "(docs/road_model.md); for one slope w_low = w_high = w. The road files and Table 2 use the "
+    "one-slope fit.")
+
+
+def table1_note(fit_quality: dict | None = None, road_model: bool = True) -> str:
+    """The paragraph under Table 1: what the uncertainty columns mean, and the gate's verdict;
+    with ``road_model`` (default: every run reports it) also what the road-model columns
+    mean (:data:`ROAD_MODEL_NOTE`)."""
     from inverse.uncertainty import R_GATE
 
     note = ("The 90 % intervals and sd columns hold noise, realisation and model-form error, "
@@ -64,6 +88,8 @@ def table1_note(fit_quality: dict | None = None) -> str:
             "the segment's data and its numbers are not a clean result.")
     if fit_quality and fit_quality.get("status") == "poor":
         note = f"**POOR FIT**: {fit_quality['message']}.\n\n" + note
+    if road_model:
+        note += " " + ROAD_MODEL_NOTE
     return note
 
 
