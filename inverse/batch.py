@@ -40,7 +40,7 @@ BATCH_FILE = "batch.json"
 
 def run_folder_names(datasets) -> list:
     """Run folder names under ROOT: each dataset folder's name; duplicates refused (one line)."""
-    names = [Path(d).resolve().name for d in datasets]
+    names = [Path(os.path.abspath(d)).name for d in datasets]    # "." named, symlinks not followed
     seen = {}
     for d, n in zip(datasets, names):
         if n in seen:
@@ -132,7 +132,7 @@ def _client(scheduler, n_workers: int, connect_timeout: float = 20.0):
 
 
 def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: str = DEFAULT_RUNNER,
-                argv=None, report=None, **kwargs) -> list:
+                argv=None, report=None, connect_timeout: float = 20.0, **kwargs) -> list:
     """Invert every dataset into ``root/<name>`` on a Dask cluster; one result per drive.
 
     Parameters
@@ -153,6 +153,8 @@ def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: s
         Command line recorded in each run.json.
     report : callable, optional
         Called with each drive's result as it finishes (the CLI prints one line).
+    connect_timeout : float
+        Seconds to wait for an existing scheduler (the sweeps' 20 s).
     **kwargs
         Passed to the runner (``workers`` is set to 1: each drive runs serially).
 
@@ -175,13 +177,14 @@ def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: s
     if root.exists() and not root.is_dir():
         raise EroadInputError(f"{root}: exists and is not a folder")
     names = run_folder_names(datasets)
-    root.mkdir(parents=True, exist_ok=True)
     kwargs = {**kwargs, "workers": 1}
     argv = list(argv) if argv is not None else ["invert_many"]
     t0 = _time.perf_counter()
     results = [None] * len(datasets)
-    with _client(scheduler, n_workers) as client:
+    with _client(scheduler, n_workers, connect_timeout) as client:
         from distributed import as_completed
+
+        root.mkdir(parents=True, exist_ok=True)
 
         futures = {client.submit(_invert_one, runner, d, str(root / n), kwargs, argv, pure=False): i
                    for i, (d, n) in enumerate(zip(datasets, names))}
