@@ -35,11 +35,13 @@ used (``--fit linear``; a simulation fit has none and the linear model is used a
    ``FeatureSpec``: the displacement and the acceleration of one wheel carry the same
    road information, so the objective already counts them once together).  ``c`` is
    the quasi-likelihood dispersion (as in QAIC/QBIC, Burnham and Anderson 2002, 6.2)
-   from the larger model: ``max(1, chi2_two / (R_REF n_features))``, with R_REF the
-   misfit per feature of correctly modelled drives (``inverse.uncertainty.R_REF``): a
-   residual far beyond noise (a vehicle the model lacks) would otherwise turn any
-   flexibility into "evidence".  The two-slope model has p = 2 more parameters
-   (w_high, n_break), so
+   from the larger model: ``max(1, chi2_two / (n_eff - 4))``, its residual per degree
+   of freedom (4 refitted parameters: ln Gq_n0, w_low, w_high, ln n_break).  A residual
+   beyond noise -- a vehicle the model lacks, or the 20-30 % excess scatter correctly
+   modelled drives show (``inverse.uncertainty.R_REF`` = 0.56 per feature against 0.5
+   expected) -- would otherwise turn any flexibility into "evidence"; dividing the gain
+   by c puts it back on the chi-square scale.  The two-slope model has p = 2 more
+   parameters (w_high, n_break), so
 
        ic_delta = (chi2_one - chi2_two) / c - 2 ln(n_eff)
 
@@ -158,7 +160,6 @@ def select_segment(linear, features, k: int, row, bounds: ParamBounds | None = N
         ``road_model``, ``w_low``, ``w_high``, ``n_break``, ``ic_delta`` and
         ``road_model_fit`` (module docstring, "Reported").
     """
-    from inverse.uncertainty import R_REF
     from roadlib.psd import two_slope_psd
 
     bounds = bounds or ParamBounds()
@@ -174,7 +175,7 @@ def select_segment(linear, features, k: int, row, bounds: ParamBounds | None = N
         return one_slope_fields(w, note="band too narrow for a break") | {
             "road_model_fit": {"objective_one": chi1, "n_features": n_feat, "n_eff": n_eff}}
     chi2 = min(chi2, chi1)      # nested: the two-slope optimum is never worse than one slope
-    disp = max(1.0, chi2 / (R_REF * n_feat))
+    disp = max(1.0, chi2 / max(n_eff - 4.0, 1.0))
     penalty = EXTRA_PARAMS * math.log(max(n_eff, 1.0))
     delta = (chi1 - chi2) / disp - penalty
     gq2, wl, wh, nb = math.exp(x2[0]), float(x2[1]), float(x2[2]), math.exp(x2[3])
