@@ -87,6 +87,16 @@ def band_mean_bias(w: float, b: float = THIRD_OCTAVE) -> float:
     return (b ** (1.0 - w) - b ** (w - 1.0)) / ((1.0 - w) * (b - 1.0 / b))
 
 
+def fitted_psd(f: dict, n: float) -> float:
+    """A fitted segment's road PSD at ``n`` [cycles/m] [m^3]: one ISO slope, or two when the
+    segment carries ``w2`` and ``n_break`` (roadlib.psd.road_psd)."""
+    if f.get("w2") is not None and f.get("n_break") is not None:
+        from roadlib.psd import road_psd
+
+        return float(road_psd(n, f["Gq_n0"], f["w"], f["w2"], f["n_break"]))
+    return float(f["Gq_n0"] * (n / 0.1) ** -f["w"])
+
+
 def reference_axle_x(truth: dict, t) -> np.ndarray:
     """Road x [m] of the reference axle at record times ``t`` [s].
 
@@ -162,7 +172,7 @@ def profile_scores(dataset: Path, truth: dict, summary: dict, track_y=REF_TRACK_
     tracks' periodogram there (:func:`window_psd`), its third-octave mean at 1 cycle/m
     and at the segment's n_best (:func:`band_mean`), and the ISO fit of the window over
     the truth's band.  Errors are ln(fit / profile); the fit's PSD at 1 cycle/m is
-    Gq_n0 (1 / 0.1)^-w.
+    Gq_n0 (1 / 0.1)^-w (:func:`fitted_psd`: two slopes where the fit has them).
     """
     from roadlib.metrics import fit_iso_psd
     from roadlib.surface import RoadSurface
@@ -187,7 +197,7 @@ def profile_scores(dataset: Path, truth: dict, summary: dict, track_y=REF_TRACK_
         except Exception as exc:   # too few bins in the band on a very short window
             r["iso_fit_error"] = str(exc)
         g1, n1 = band_mean(est, 1.0)
-        g1_fit = f["Gq_n0"] * (1.0 / 0.1) ** -f["w"]
+        g1_fit = fitted_psd(f, 1.0)
         r.update(G1_prof=g1, G1_fit=g1_fit, G1_bins=n1, lnG_1cpm_err=math.log(g1_fit / g1))
         if "n_best" in f:
             gb, nb = band_mean(est, f["n_best"])
@@ -216,8 +226,8 @@ def score_case(truth: dict, summary: dict) -> dict:
                      "dw": abs(f["w"] - s["w"]), "class_true": class_of(s["Gq_n0"]),
                      "class_fit": class_of(f["Gq_n0"]),
                      # the PSD at 1 cycle/m (~10 Hz at 10 m/s, where the truck responds)
-                     "dlnG_1cpm": abs(math.log(f["Gq_n0"] / s["Gq_n0"]) - (f["w"] - s["w"]) * math.log(10.0)),
-                     "lnG_1cpm_err": math.log(f["Gq_n0"] / s["Gq_n0"]) - (f["w"] - s["w"]) * math.log(10.0),
+                     "dlnG_1cpm": abs(math.log(fitted_psd(f, 1.0) / (s["Gq_n0"] * 10.0 ** -s["w"]))),
+                     "lnG_1cpm_err": math.log(fitted_psd(f, 1.0) / (s["Gq_n0"] * 10.0 ** -s["w"])),
                      # signed errors and what the fit reported, for the interval calibration
                      "lnGq_err": math.log(f["Gq_n0"] / s["Gq_n0"]), "w_err": f["w"] - s["w"],
                      "sd_ln_Gq_n0": f["sd"]["ln_Gq_n0"], "sd_w": f["sd"]["w"],

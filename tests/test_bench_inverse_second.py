@@ -88,3 +88,12 @@ def test_measured_truth_and_profile_scores_use_the_driven_window(tmp_path):
     gb, _ = B.band_mean(est, 1.0)
     assert r["lnG_1cpm_err"] == pytest.approx(math.log(g1 / gb))
     assert r["lnG_n_best_err"] == pytest.approx(r["lnG_1cpm_err"])
+
+
+def test_fitted_psd_one_and_two_slopes():
+    f = {"Gq_n0": 2.0e-4, "w": 2.5}
+    assert B.fitted_psd(f, 1.0) == pytest.approx(2.0e-4 * 10.0 ** -2.5, rel=1e-12)
+    # two slopes: w below the break at 0.5 cycles/m, w2 above (continuous at the break)
+    f2 = dict(f, w2=3.5, n_break=0.5)
+    assert B.fitted_psd(f2, 1.0) == pytest.approx(2.0e-4 * 5.0 ** -2.5 * 2.0 ** -3.5, rel=1e-12)
+    assert B.fitted_psd(f2, 0.3) == pytest.approx(B.fitted_psd(f, 0.3), rel=1e-12)
