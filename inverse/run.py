@@ -215,7 +215,6 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         fit_seed = stream_seed(seed, SEED_KEY_FIT)
         seeds = [fit_seed] + candidate_seeds(seed, n_cand)
         labels = ["fit"] + [f"c{i}" for i in range(n_cand)]
-        t1 = _time.perf_counter()
         table_ch = [c for c in TABLE2_CHANNELS if c in chans]
         sel_map = map_fn
         if bar is not None:
@@ -227,39 +226,65 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                 for r in map_fn(func, items):
                     bar.update(1)
                     yield r
-        # one seed for both tracks: a per-side choice by the reported RMS would tune Table 2 to itself
-        if selection == "linear" and n_cand > 0:
-            from inverse.linear_response import LinearRealisation
-
-            sel = select_realisation_linear(sim, LinearRealisation(sim), params, chans, seeds,
-                                            table_channels=table_ch, map_fn=sel_map, labels=labels,
-                                            per_round=max(1, workers))
-        else:
-            sel = select_realisation(sim, params, chans, seeds, table_channels=table_ch, map_fn=sel_map,
-                                     labels=labels, sides=False)
-            sel.update(method="simulation", n_simulated=len(seeds), fit_simulated=sel.pop("simulated_all")[0])
-        timing["selection_s"] = _time.perf_counter() - t1
-        timing["selection_sims"] = int(sel["n_simulated"])
-        t1 = _time.perf_counter()
-        if bar is not None:
-            bar.set_description("invert: report")
         from drives.format import swap_into_place, temp_folder_beside
 
         out.parent.mkdir(parents=True, exist_ok=True)
         tmp = temp_folder_beside(out)
         (tmp / "tables").mkdir()
-        try:
-            # the figures in a worker while this process writes the rest (report.write_figures)
+
+        def select_and_draw():
+            """The realisation selection, then the figures (in a worker when there is a pool)."""
+            t = _time.perf_counter()
+            # one seed for both tracks: a per-side choice by the reported RMS would tune Table 2 to itself
+            if selection == "linear" and n_cand > 0:
+                from inverse.linear_response import LinearRealisation
+
+                sel = select_realisation_linear(sim, LinearRealisation(sim), params, chans, seeds,
+                                                table_channels=table_ch, map_fn=sel_map, labels=labels,
+                                                per_round=max(1, workers))
+            else:
+                sel = select_realisation(sim, params, chans, seeds, table_channels=table_ch, map_fn=sel_map,
+                                         labels=labels, sides=False)
+                sel.update(method="simulation", n_simulated=len(seeds), fit_simulated=sel.pop("simulated_all")[0])
+            timing["selection_s"] = _time.perf_counter() - t
+            timing["selection_sims"] = int(sel["n_simulated"])
+            if bar is not None:
+                bar.set_description("invert: report")
             fig_kw = dict(time=time, measured=chans, simulated=sel["simulated"], segmentation=inv.segmentation,
                           seg_signal=chans["susp_disp_3L"], title=f"({drive.name})")
             figures = pool.submit(write_figures, tmp / "figures", **fig_kw) if pool is not None else None
-            simulated = sel["simulated"]
-            rows = response_table(chans, simulated, table_ch)
-            fit_rows = response_table(chans, sel["fit_simulated"], table_ch) if sel["label"] != "fit" else rows
+            return sel, fig_kw, figures
+
+        sel_thread = None
+        try:
+            # With a pool, the selection (and then the figures) run from a thread of this process
+            # on the pool's workers, while this process computes what needs the fit only: the
+            # road model and the lateral-structure sensitivity.
+            if pool is not None:
+                from concurrent.futures import ThreadPoolExecutor
+                sel_thread = ThreadPoolExecutor(1)
+                sel_job = sel_thread.submit(select_and_draw)
+            t = _time.perf_counter()
             segs = inv.segments()
             # the road model of each segment, one ISO slope or two (inverse.road_model)
             from inverse.road_model import add_road_models, select_road_models
             add_road_models(segs, select_road_models(inv, sim, speed, road_model))
+            timing["road_model_s"] = _time.perf_counter() - t
+            from inverse.lateral import note_line, run_summary
+
+            t = _time.perf_counter()
+            lateral = run_summary(drive.vehicle, segs, time, speed, list(chans), effects=effects, chassis=chassis)
+            timing["lateral_s"] = _time.perf_counter() - t
+            if sel_thread is None:
+                sel, fig_kw, figures = select_and_draw()
+            else:
+                try:
+                    sel, fig_kw, figures = sel_job.result()
+                finally:
+                    sel_thread.shutdown()
+            simulated = sel["simulated"]
+            rows = response_table(chans, simulated, table_ch)
+            fit_rows = response_table(chans, sel["fit_simulated"], table_ch) if sel["label"] != "fit" else rows
             summary = {
                 "format": RUN_FORMAT,
                 "dataset": {"name": drive.name, "path": dataset_path(dataset, out), "vehicle": str(drive.vehicle),
@@ -284,10 +309,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                 "road": {"file": "road.npz", "crg": "road.crg", "seed": sel["seed"], "dx": SIM_DX,
                          "seg_lengths_m": [float(v) for v in sim.layout()["seg_lengths"]]},
             }
-            from inverse.lateral import note_line, run_summary
-
-            summary["lateral"] = run_summary(drive.vehicle, segs, time, speed, list(chans),
-                                             effects=effects, chassis=chassis)
+            summary["lateral"] = lateral
             write_table(table1(segs), tmp / "tables" / "table1",
                         note=table1_note(summary["fit_quality"]) + "\n\n" + note_line(summary["lateral"]))
             write_table(table2(rows, sel["spread"]), tmp / "tables" / "table2", note=TABLE2_NOTE)
@@ -314,8 +336,10 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                 write_figures(tmp / "figures", **fig_kw)
             else:
                 figures.result()
-            timing["report_s"] = _time.perf_counter() - t1
             timing["total_s"] = _time.perf_counter() - t0
+            # the wall the report adds after the selection (the road model and the lateral
+            # summary ran during the selection when there was a pool)
+            timing["report_s"] = timing["total_s"] - timing["fit_s"] - timing["selection_s"]
             timing["n_sims"] = int(inv.fit.n_sims + sel["n_simulated"])
             timing["workers"] = workers
             summary["timing"] = timing
@@ -324,6 +348,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             write_run_json(tmp, finish_run_info(record, "complete", wall_s=timing["total_s"]))
             swap_into_place(tmp, out)   # an old RUN (--force) is removed only once the new one is in place
         except BaseException:
+            if sel_thread is not None:
+                sel_thread.shutdown(wait=False, cancel_futures=True)
             shutil.rmtree(tmp, ignore_errors=True)
             raise
     finally:
