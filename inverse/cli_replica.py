@@ -32,6 +32,9 @@ def register(subparsers) -> None:
     p.add_argument("--holdout", default="2", metavar="AXLE|none",
                    help="axle whose channels are left out of a second reconstruction and predicted from it "
                         "(validation, shown in red in figures/replica_time.png; default 2; 'none' skips it)")
+    p.add_argument("--lines", choices=("tyre", "track"), default="tyre",
+                   help="unknowns per side: a profile per lateral tyre position, coupled by the road's lateral "
+                        "structure (default), or one track for all tyres of a side")
     p.add_argument("--json", action="store_true", help="print summary.json to stdout")
     p.add_argument("--force", action="store_true", help="replace an existing RUN")
     p.set_defaults(func=_cmd_replica)
@@ -60,7 +63,7 @@ def _cmd_replica(args) -> int:
                                   "(e.g. from 'eroad diagnose')")
         from vehicles.effects import parse_effects
         effects = parse_effects(args.effects)
-    summary = run_replica(args.dataset, args.out, effects=effects, noise_sd=_noise(args.noise),
+    summary = run_replica(args.dataset, args.out, effects=effects, noise_sd=_noise(args.noise), lines=args.lines,
                           holdout=_holdout(args.holdout), force=args.force, argv=sys.argv,
                           progress=lambda m: print(m, file=sys.stderr, flush=True))
     if args.json:

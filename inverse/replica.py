@@ -121,7 +121,7 @@ class ReplicaOperator:
     """
 
     def __init__(self, lm, time, speed, channels, dx: float = DX, substeps: int = SUBSTEPS,
-                 runin_s: float = RUNIN_S):
+                 runin_s: float = RUNIN_S, lines: str = "track"):
         time = np.asarray(time, float)
         speed = np.asarray(speed, float)
         self.lm, self.channels, self.dx = lm, list(channels), float(dx)
@@ -139,6 +139,8 @@ class ReplicaOperator:
         self.s_record = sf[self.i_out]
         xs = np.array([c["x"] for c in lm.contacts], float)
         sides = [0 if c["side"] == "L" else 1 for c in lm.contacts]
+        self.blocks, blocks_of = unknown_blocks(lm.contacts, lines)
+        self.lines, self.blocks_of = lines, blocks_of
         j0 = math.floor((sf[0] + xs.min()) / dx) - 2
         j1 = math.ceil((sf[-1] + xs.max()) / dx) + 2
         N = j1 - j0 + 1
@@ -152,15 +154,17 @@ class ReplicaOperator:
             pos = (sf + xs[c] - self.x[0]) / dx
             j = np.clip(np.floor(pos).astype(int), 0, N - 2)
             fr = pos - j
-            off = sides[c] * N
-            rows += [c * nf + ii, c * nf + ii, (nc + c) * nf + ii, (nc + c) * nf + ii]
-            cols += [off + j, off + j + 1, off + j, off + j + 1]
-            vals += [1.0 - fr, fr, -vf / dx, vf / dx]
+            for b in blocks_of[c]:          # the track of its side, and its own line's deviation
+                off = b * N
+                rows += [c * nf + ii, c * nf + ii, (nc + c) * nf + ii, (nc + c) * nf + ii]
+                cols += [off + j, off + j + 1, off + j, off + j + 1]
+                vals += [1.0 - fr, fr, -vf / dx, vf / dx]
             jr = j[self.i_out]
             covered[np.arange(jr.min(), jr.max() + 2)] = True
         self.covered = covered
+        self.n_blocks = len(self.blocks)
         self.Mu = sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                                 shape=(2 * nc * nf, 2 * N))
+                                 shape=(2 * nc * nf, self.n_blocks * N))
         self.nf, self.nc = nf, nc
         # continuous state space x = [q, q'], u = [z_r, z_r'] -> outputs
         A, B = lm.state_space()
@@ -189,7 +193,19 @@ class ReplicaOperator:
 
     @property
     def n_unknowns(self) -> int:
-        return 2 * self.n_grid
+        return self.n_blocks * self.n_grid
+
+    def line_heights(self, u: np.ndarray) -> list:
+        """Heights [m] of every tyre line (track plus the line's deviation) from the
+        unknown vector ``u``: list of (side, y [m], (N,) array), left lines first."""
+        u = np.asarray(u, float).reshape(self.n_blocks, self.n_grid)
+        out = []
+        for b, blk in enumerate(self.blocks):
+            if blk["kind"] == "line":
+                out.append((blk["side"], blk["y"], u[blk["track"]] + u[b]))
+        if not out:   # one line per side (or lines="track"): the tracks are the lines
+            out = [(blk["side"], blk["y"], u[b].copy()) for b, blk in enumerate(self.blocks)]
+        return out
 
     def _modal(self, g: np.ndarray) -> np.ndarray:
         out = np.empty_like(g)
@@ -222,6 +238,82 @@ class ReplicaOperator:
         z = np.concatenate([z_left, z_left if z_right is None else z_right])
         u = (self.Mu @ z).reshape(2 * self.nc, self.nf)
         return u[:self.nc], u[self.nc:]
+
+
+#: how the unknowns are laid out: "tyre" (default of :func:`reconstruct`): per side a track
+#: plus, for every distinct lateral tyre position of that side, the line's deviation from
+#: it; "track": one profile per side for all its tyres (dual tyres and different track
+#: widths taken as one track)
+LINE_MODES = ("tyre", "track")
+#: lateral positions closer than this are one tyre line [m]
+LINE_Y_TOL = 0.02
+#: smallest lateral distance of a line from its side's centre used in its prior [m]
+LINE_DY_MIN = 0.05
+
+
+def unknown_blocks(contacts, lines: str = "track") -> tuple:
+    """Blocks of N unknowns and which blocks each tyre's road height sums.
+
+    Returns ``(blocks, blocks_of)``: ``blocks`` a list of dicts -- ``{"kind": "track",
+    "side", "y"}`` for the two tracks (y the mean of the side's line positions), then
+    ``{"kind": "line", "side", "y", "track": index, "dy": distance from the track's y}``
+    per tyre line of a side with more than one line (mode "tyre"); ``blocks_of[c]`` the
+    block indices whose sum is tyre c's road height.
+    """
+    if lines not in LINE_MODES:
+        raise EroadInputError(f"replica lines {lines!r}: use one of {', '.join(LINE_MODES)}")
+    per_side = {"L": [], "R": []}
+    for c in contacts:
+        ys = per_side[c["side"]]
+        if not any(abs(c["y"] - y) <= LINE_Y_TOL for y in ys):
+            ys.append(float(c["y"]))
+    blocks = [{"kind": "track", "side": s, "y": float(np.mean(per_side[s])) if per_side[s] else 0.0}
+              for s in ("L", "R")]
+    line_index = {}
+    if lines == "tyre":
+        for t, s in enumerate(("L", "R")):
+            if len(per_side[s]) < 2:
+                continue
+            for y in sorted(per_side[s], key=abs):
+                line_index[(s, y)] = len(blocks)
+                blocks.append({"kind": "line", "side": s, "y": y, "track": t,
+                               "dy": max(abs(y - blocks[t]["y"]), LINE_DY_MIN)})
+    blocks_of = []
+    for c in contacts:
+        b = [0 if c["side"] == "L" else 1]
+        for (s, y), k in line_index.items():
+            if s == c["side"] and abs(c["y"] - y) <= LINE_Y_TOL:
+                b.append(k)
+        blocks_of.append(b)
+    return blocks, blocks_of
+
+
+def block_frf(lm, n, speed: float, channels, blocks_of, n_blocks: int) -> np.ndarray:
+    """FRFs (nf, n_channels, n_blocks) from each unknown block's profile at spatial
+    frequency ``n`` and constant ``speed`` (wheelbase delays included; the
+    generalisation of ``LinearModel.track_frf`` to the tyre-line blocks)."""
+    f = np.asarray(n, float) * speed
+    H = lm.frf(f, channels)
+    xs = np.array([c["x"] for c in lm.contacts])
+    E = np.exp(1j * 2 * np.pi * f[:, None] * xs[None, :] / speed)
+    out = np.zeros(H.shape[:2] + (n_blocks,), complex)
+    for c, bs in enumerate(blocks_of):
+        for b in bs:
+            out[:, :, b] += H[:, :, c] * E[:, c][:, None]
+    return out
+
+
+def line_weights(blocks, alpha: float, dx: float = DX) -> np.ndarray:
+    """Prior weight [1/m^2] on the squared deviation of each block (0 for the tracks).
+
+    DECISION (docs/replica.md): the deviation e of a tyre line at lateral distance dy
+    from its side's track is taken as white with the variance of the height difference
+    of an isotropic road at that distance.  For the w = 2 road of the prior the
+    structure function is linear, D(r) = E[(z(p) - z(p + r))^2] = r / (alpha dx)
+    (alpha = 1 / D(dx) along x, the same in every direction when the road is
+    isotropic), so the weight is 1 / D(dy) = alpha dx / dy.
+    """
+    return np.array([0.0 if b["kind"] == "track" else alpha * dx / b["dy"] for b in blocks])
 
 
 def first_difference(N: int) -> sps.csr_matrix:
@@ -338,6 +430,8 @@ class Replica:
     fitted: dict
     info: dict = field(default_factory=dict)
     operator: object = None
+    u: np.ndarray = None
+    lines: list = field(default_factory=list)
 
     def predict(self, channels) -> dict:
         """Responses of the linear model on the replica for any channels (e.g. held out)."""
@@ -345,8 +439,9 @@ class Replica:
 
 
 def _predict(op: ReplicaOperator, rep: Replica, channels) -> dict:
-    other = ReplicaOperator(op.lm, op._time, op._speed, channels, op.dx, op._substeps, op._runin_s)
-    Y = other.forward(np.concatenate([rep.z_left, rep.z_right]))
+    other = ReplicaOperator(op.lm, op._time, op._speed, channels, op.dx, op._substeps, op._runin_s,
+                            lines=op.lines)
+    Y = other.forward(rep.u)
     return {c: Y[k] for k, c in enumerate(channels)}
 
 
@@ -451,7 +546,7 @@ def _local_speed(op: ReplicaOperator, lm, speed) -> np.ndarray:
 def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, dx: float = DX,
                 substeps: int = SUBSTEPS, runin_s: float = RUNIN_S, em_rounds: int = 3,
                 alpha: float | None = None, tol: float = 1e-6, max_iter: int = 120, first_iter: int = 40,
-                progress=None) -> Replica:
+                lines: str = "tyre", progress=None) -> Replica:
     """Reconstruct the two wheel tracks from response channels (module docstring).
 
     Regularisation weight and channel weights (DECISION, docs/replica.md): empirical
@@ -493,7 +588,7 @@ def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, d
         raise EroadInputError("replica: speed and time differ in length")
     if not np.all(np.isfinite(speed)) or np.min(speed) <= 0.5:
         raise EroadInputError("replica: needs a moving vehicle (speed > 0.5 m/s throughout)")
-    op = ReplicaOperator(lm, time, speed, names, dx, substeps, runin_s)
+    op = ReplicaOperator(lm, time, speed, names, dx, substeps, runin_s, lines=lines)
     op._time, op._speed, op._substeps, op._runin_s = np.asarray(time, float), speed, substeps, runin_s
     Y = np.array([np.asarray(channels[c], float) for c in names])
     Y = Y - Y.mean(axis=1, keepdims=True)          # static offsets (sensor zero) are not road
@@ -502,12 +597,13 @@ def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, d
     sig0 = np.array([sensor[c] for c in names])
     sig = sig0.copy()
     N = op.n_grid
+    nb = op.n_blocks
     Dm = first_difference(N)
-    DtD = (Dm.T @ Dm).tocsr()
+    DtD = (Dm.T @ Dm).tocsr()          # the two tracks' first differences (2N, 2N)
     v_loc = _local_speed(op, lm, speed)
     fixed_alpha = alpha is not None
     al = float(alpha) if fixed_alpha else alpha_of_gd0(GD0_START, dx)
-    z = np.zeros(2 * N)
+    z = np.zeros(nb * N)
     hist = []
     v_med = float(np.median(speed))
     n_fft = np.fft.rfftfreq(4096, dx)[1:]
@@ -517,9 +613,12 @@ def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, d
         last = rnd == rounds - 1
         w = 1.0 / sig ** 2
         eps = EPS_REL * al
+        beta = np.repeat(line_weights(op.blocks, al, dx), N)      # tyre-line deviations
 
-        def normal(v, w=w, al=al, eps=eps):
-            return op.adjoint(w[:, None] * op.forward(v)) + al * (DtD @ v) + eps * v
+        def normal(v, w=w, al=al, eps=eps, beta=beta):
+            out = op.adjoint(w[:, None] * op.forward(v)) + eps * v + beta * v
+            out[:2 * N] += al * (DtD @ v[:2 * N])
+            return out
 
         b = op.adjoint(w[:, None] * Y)
         z, it, rel = _cg(normal, b, z, tol, max_iter if last else first_iter)
@@ -537,7 +636,7 @@ def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, d
         # EM updates
         sig = np.sqrt(np.maximum(sig0 ** 2, ms))
         cov = np.concatenate([op.covered[:-1], op.covered[:-1]])
-        dz = (Dm @ z)[cov]
+        dz = (Dm @ z[:2 * N])[cov]
         # posterior variance of a first difference, constant-speed picture (per metre)
         H = lm.track_frf(n_fft * v_med, v_med, names)
         wpm = (fs * dx / v_med) / sig ** 2
@@ -557,13 +656,16 @@ def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, d
     lam_min[~op.covered] = np.nan
     lam_max[~op.covered] = np.nan
     info = {"cg_iterations": total_it, "em": hist, "wall_s": _time.perf_counter() - t0,
-            "n_unknowns": 2 * N, "n_samples": int(Y.size), "substeps": substeps, "runin_s": runin_s,
+            "n_unknowns": nb * N, "n_samples": int(Y.size), "substeps": substeps, "runin_s": runin_s,
             "speed_quantiles_mps": speeds.tolist(), "band_at_speed_m": bands.tolist(),
             "linear_model_notes": list(lm.meta.get("notes", []))}
-    return Replica(x=op.x, z_left=z[:N], z_right=z[N:], covered=op.covered, lambda_min=lam_min,
-                   lambda_max=lam_max, channels=names, sigma=dict(zip(names, sig.tolist())),
-                   sigma_sensor=sensor, alpha=al, gd0=gd0_of_alpha(al, dx),
-                   fitted={c: fitted[k] + 0.0 for k, c in enumerate(names)}, info=info, operator=op)
+    info["lines"] = lines
+    info["line_blocks"] = [{k: v for k, v in b.items()} for b in op.blocks]
+    return Replica(x=op.x, z_left=z[:N].copy(), z_right=z[N:2 * N].copy(), covered=op.covered,
+                   lambda_min=lam_min, lambda_max=lam_max, channels=names,
+                   sigma=dict(zip(names, sig.tolist())), sigma_sensor=sensor, alpha=al,
+                   gd0=gd0_of_alpha(al, dx), fitted={c: fitted[k] + 0.0 for k, c in enumerate(names)},
+                   info=info, operator=op, u=z, lines=op.line_heights(z))
 
 
 # --------------------------------------------------------------------------- scoring helpers
@@ -597,32 +699,71 @@ def nrmse(pred, meas) -> float:
 # --------------------------------------------------------------------------- the run folder
 #: run-folder format version of ``eroad replica``
 RUN_FORMAT = 1
-#: lateral road grid of the written 3D road [m] (tracks beyond |y| = HALF_GAP, blended between)
-ROAD_Y_HALF_WIDTH, ROAD_DY, HALF_GAP = 1.5, 0.1, 0.5
+#: lateral road grid of the written 3D road [m]: half width and step (0.02 m puts every
+#: tyre line of the trucks here, |y| = 0.76, 1.02, 1.10 m, on a grid line, so a tyre at
+#: its own lateral position reads its line exactly)
+ROAD_Y_HALF_WIDTH, ROAD_DY = 1.5, 0.02
+
+
+def line_column(side: str, y: float) -> str:
+    """tracks.csv column of a tyre line, e.g. ``z_L_y1.02_m``."""
+    return f"z_{side}_y{abs(float(y)):.2f}_m"
 
 
 def replica_surface(rep: Replica):
-    """The replica as a RoadSurface: z_L for y >= HALF_GAP, z_R for y <= -HALF_GAP, linear
-    in between (every tyre of the trucks here runs at |y| >= 0.76 m, so it sees its
-    track exactly).  DECISION: no lateral field is invented beside the tracks."""
+    """The replica as a RoadSurface: every reconstructed line at its lateral position,
+    linear in y between neighbouring lines, held beyond the outermost ones.
+
+    DECISION (docs/replica.md): the lateral field is the conditional mean of the road
+    prior given the lines, not a random draw.  Across y at fixed x, a w = 2 road is a
+    random walk (structure function linear in distance), and the conditional mean of a
+    random walk between two known points is the straight line between them, beyond the
+    last known point its value there -- so linear interpolation and holding is the
+    prior's best estimate, and no texture that the data did not show is invented.  Its
+    uncertainty grows with the distance r to the nearest line, sd ~ sqrt(r / (alpha dx))
+    (``summary.json`` ``lateral_field``).  With ``lines="track"`` each track covers the
+    lateral span of its side's tyres (every tyre reads its track exactly).
+    """
     from roadlib.surface import RoadSurface
 
     y = np.round(np.arange(-ROAD_Y_HALF_WIDTH, ROAD_Y_HALF_WIDTH + 1e-9, ROAD_DY), 10)
-    a = np.clip((y + HALF_GAP) / (2 * HALF_GAP), 0.0, 1.0)            # 0 right .. 1 left
-    z = rep.z_right[:, None] * (1 - a[None, :]) + rep.z_left[:, None] * a[None, :]
-    meta = {"generator": "inverse.replica", "tracks": "z_left for y >= 0.5 m, z_right for y <= -0.5 m",
+    knots = []                      # (y, profile) sorted by y, a side's span as two knots
+    op = rep.operator
+    if rep.lines and op is not None and op.lines == "tyre" and len(rep.lines) > 2:
+        knots = [(float(yl), z) for _, yl, z in rep.lines]
+    else:
+        for side, z in (("L", rep.z_left), ("R", rep.z_right)):
+            ys = [c["y"] for c in op.lm.contacts if c["side"] == side] if op is not None else [0.96 if side == "L" else -0.96]
+            knots += [(float(min(ys)), z), (float(max(ys)), z)]
+    knots.sort(key=lambda k: k[0])
+    yk = np.array([k[0] for k in knots])
+    Z = np.stack([k[1] for k in knots], axis=1)              # (N, n_knots)
+    z = np.empty((rep.x.size, y.size))
+    for i, yi in enumerate(y):
+        if yi <= yk[0]:
+            z[:, i] = Z[:, 0]
+        elif yi >= yk[-1]:
+            z[:, i] = Z[:, -1]
+        else:
+            k = int(np.searchsorted(yk, yi, side="right")) - 1
+            a = 0.0 if yk[k + 1] == yk[k] else (yi - yk[k]) / (yk[k + 1] - yk[k])
+            z[:, i] = (1 - a) * Z[:, k] + a * Z[:, k + 1]
+    meta = {"generator": "inverse.replica",
+            "lines_y_m": ", ".join(f"{v:.2f}" for v in yk),
+            "lateral": "linear between reconstructed lines, held beyond (conditional mean of a w = 2 road)",
             "x_origin": "first axle at the dataset's first sample"}
     return RoadSurface(rep.x, y, z, meta)
 
 
 def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: bool = False,
-                argv=None, progress=None) -> dict:
+                argv=None, progress=None, lines: str = "tyre") -> dict:
     """``eroad replica``: reconstruct, score the hold-out, write the run folder.
 
     RUN (written into a temporary sibling folder and renamed into place, like
     ``eroad invert``)::
 
-        tracks.csv          x_m, z_left_m, z_right_m, identified, lambda_min_m, lambda_max_m
+        tracks.csv          x_m, z_left_m, z_right_m, identified, lambda_min_m, lambda_max_m,
+                            z_<side>_y<|y|>_m per tyre line (lines="tyre")
         iri.csv             track, segment_m (20, 100), start_m, end_m, iri_m_per_km
         psd.csv             n_cpm, G_left_m3, G_right_m3 (Welch over the identified stretch)
         road.npz, road.crg  the two tracks as a 3D road (replica_surface)
@@ -640,6 +781,8 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
     holdout : int or None
         Axle whose channels are left out of a second reconstruction and predicted
         from it (validation); None: none.
+    lines : {"tyre", "track"}
+        Unknowns per side: a line per lateral tyre position (default) or one track.
     """
     import json
     import shutil
@@ -679,7 +822,9 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         psd = noise_psd_from_sd(noise_sd, names, drive.sample_rate_hz)
         noise = {c: math.sqrt(p * 0.5 * drive.sample_rate_hz) for c, p in psd.items()}
     chans = {c: drive.channels[c].to_numpy(float) for c in names}
-    rep = reconstruct(lm, drive.time, drive.speed, chans, noise=noise, progress=progress)
+    if lines not in LINE_MODES:
+        raise EroadInputError(f"--lines {lines!r}: use one of {', '.join(LINE_MODES)}")
+    rep = reconstruct(lm, drive.time, drive.speed, chans, noise=noise, progress=progress, lines=lines)
     held, pred, rep2 = [], {}, None
     if holdout is not None:
         held = [c for c in names if axle_of(c) == int(holdout)]
@@ -688,7 +833,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
             raise EroadInputError(f"--holdout {holdout}: the drive has no channels of axle {holdout}, or "
                                   f"only those")
         rep2 = reconstruct(lm, drive.time, drive.speed, {c: chans[c] for c in keep}, noise=noise,
-                           progress=progress)
+                           progress=progress, lines=lines)
         pred = rep2.predict(held)
     dx = float(rep.x[1] - rep.x[0])
     cov = rep.covered
@@ -699,10 +844,12 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
     tmp = temp_folder_beside(out)
     (tmp / "figures").mkdir()
     try:
-        pd.DataFrame({"x_m": rep.x, "z_left_m": rep.z_left, "z_right_m": rep.z_right,
-                      "identified": ident.astype(int), "lambda_min_m": rep.lambda_min,
-                      "lambda_max_m": rep.lambda_max}).to_csv(tmp / "tracks.csv", index=False,
-                                                              float_format="%.9g")
+        cols = {"x_m": rep.x, "z_left_m": rep.z_left, "z_right_m": rep.z_right,
+                "identified": ident.astype(int), "lambda_min_m": rep.lambda_min,
+                "lambda_max_m": rep.lambda_max}
+        if rep.operator.lines == "tyre":
+            cols.update({line_column(side, yl): zl for side, yl, zl in rep.lines})
+        pd.DataFrame(cols).to_csv(tmp / "tracks.csv", index=False, float_format="%.9g")
         rows = []
         iri = {}
         for side, z in (("left", rep.z_left), ("right", rep.z_right)):
@@ -737,6 +884,13 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
                         "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz,
                         "warnings": list(drive.warnings)},
             "method": "time-domain MAP input estimation on the linear model (docs/replica.md)",
+            "lines": {"layout": rep.operator.lines,
+                      "tyre_lines": [{"side": side, "y_m": float(yl), "column": line_column(side, yl)}
+                                     for side, yl, _ in rep.lines] if rep.operator.lines == "tyre" else [],
+                      "tracks": "z_left_m / z_right_m: the common profile of each side's tyre lines"
+                                if rep.operator.lines == "tyre" else "one profile per side for all its tyres",
+                      "lateral_field": {"method": "linear between lines, held beyond (conditional mean)",
+                                        "sd_at_0.5m_from_a_line_m": float(math.sqrt(0.5 / (rep.alpha * dx)))}},
             "grid": {"dx_m": dx, "x_start_m": float(rep.x[0]), "x_end_m": float(rep.x[-1]),
                      "covered_m": [float(xc[0]), float(xc[-1])]},
             "identified_band_m": {"median_lambda_min": lam_lo, "median_lambda_max": lam_hi,
@@ -764,7 +918,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         import tomli_w
         cfg = {"dataset": str(Path(dataset).resolve()), "effects": json.dumps(effects or {}),
                "noise_sd": dict(noise_sd or {}), "holdout": -1 if holdout is None else int(holdout),
-               "dx_m": dx, "substeps": rep.info["substeps"], "runin_s": rep.info["runin_s"]}
+               "dx_m": dx, "substeps": rep.info["substeps"], "runin_s": rep.info["runin_s"], "lines": lines}
         (tmp / "config.toml").write_text(tomli_w.dumps(cfg))
         write_run_json(tmp, finish_run_info(record, "complete", wall_s=_time.perf_counter() - t0))
         swap_into_place(tmp, out)
