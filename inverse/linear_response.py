@@ -11,10 +11,10 @@ from an :class:`inverse.truck.TruckSimulator`: same road (``TruckSimulator.road`
 layout (run-in, start position, speed profile), same channels.
 
 What it is not: exact for nonlinear effects (leaf friction, bump stops, asymmetric
-dampers are left out of the linear model, :func:`inverse.linear_features.linear_model_for`)
-nor for effects that change the road the tyres feel (tyre enveloping): their share is
-what the selection's correction by simulated candidates carries (docs/inverse.md,
-section 12).
+dampers are left out of the linear model, :func:`inverse.linear_features.linear_model_for`):
+their share is what the selection's correction by simulated candidates carries
+(docs/inverse.md, section 12).  Linear effects are in the linear model; tyre enveloping's
+footprint filter is applied to the road as the effect applies it.
 
 Method
 ------
@@ -128,6 +128,18 @@ class LinearRealisation:
         if self.i_out[-1] > n_steps:
             self.i_out = self.i_out[self.i_out <= n_steps]
         self.n_run, self.n_rec = int(lay["n_runin"]), int(simulator.time.size)
+        self.footprint = float(getattr(lm, "footprint", 0.0) or 0.0)   # tyre_enveloping's contact length
+        # effects that post-process the simulated channels (sensor dynamics and noise): applied
+        # here as vehicles.simulate applies them, on the whole output (run-in included), to every
+        # wheel-station channel in the simulator's order (the noise streams follow that order)
+        from vehicles.effects import EFFECTS, resolve_effects
+        from vehicles.effects.base import Effect
+
+        self._effects = resolve_effects(simulator.effects) if simulator.effects else {}
+        self._post = any(type(EFFECTS[n]).outputs is not Effect.outputs for n in self._effects)
+        self._order = [f"{q}_{a + 1}{side}" for q in ("susp_disp", "axle_acc", "body_acc")
+                       for a in range(len(vp.axles)) for side in ("L", "R")]
+        self._chassis, self._fs = simulator.chassis, float(lay["fs"])
         self.dt, self.n_sub = dt, n_sub
         self._discretise(lm)
 
@@ -163,7 +175,10 @@ class LinearRealisation:
 
     # ------------------------------------------------------------------ input
     def road_input(self, road) -> np.ndarray:
-        """``u = [z_r; z_r']`` (2 n_contacts, steps) under the tyres on ``road`` (as the simulator)."""
+        """``u = [z_r; z_r']`` (2 n_contacts, steps) under the tyres on ``road`` (as the simulator;
+        with the ``tyre_enveloping`` effect the road filtered by the footprint, as that effect does)."""
+        if self.footprint > 0:
+            road = road.footprint_filtered(self.footprint)
         gx = np.asarray(road.x, float)
         dx = float(road.dx)
         lo, hi = self.x_contact.min() + self.s_steps[0], self.x_contact.max() + self.s_steps[-1]
@@ -193,6 +208,8 @@ class LinearRealisation:
             xi = lfilter([0.0, 1.0], [1.0, -lm_], g[m])[self.i_out]
             acc += np.real(self.Cm[:, m:m + 1] * xi[None, :])
         y[:] = acc + self.Dd @ du[:, self.i_out] + (self.G_static @ u0[:nc])[:, None]
+        if self._post:
+            y = self._post_process(y)
         a, b = self.n_run, self.n_run + self.n_rec
         out = {}
         for k, c in enumerate(self.channels):
@@ -201,6 +218,23 @@ class LinearRealisation:
                 v = np.concatenate([v, np.full(self.n_rec - v.size, v[-1])])
             out[c] = v
         return out
+
+    def _post_process(self, y: np.ndarray) -> np.ndarray:
+        from vehicles.effects import EFFECTS
+        from vehicles.effects.base import EffectContext
+        from vehicles.params import load_vehicle
+
+        vp = load_vehicle(self.simulator.vehicle)
+        ctx = EffectContext(vp=vp, reference_vp=vp, chassis=self._chassis, fs_out=self._fs, dt=self.dt, seed=0)
+        for name, p in self._effects.items():
+            EFFECTS[name].configure(ctx, p)
+        mine = {c: k for k, c in enumerate(self.channels)}
+        chans = {c: (y[mine[c]].copy() if c in mine else np.zeros(y.shape[1])) for c in self._order}
+        chans.update({c: y[k].copy() for c, k in mine.items() if c not in chans})
+        t = np.arange(y.shape[1]) / self._fs
+        for name, p in self._effects.items():
+            EFFECTS[name].outputs(t, chans, p, ctx)
+        return np.array([chans[c] for c in self.channels])
 
     def response(self, road) -> dict:
         """Channel -> (N,) array on the record's time grid for ``road`` (noise-free)."""

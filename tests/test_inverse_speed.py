@@ -24,14 +24,18 @@ def drive(tmp_path_factory):
     return read_drive(root / "ds")
 
 
-def test_linear_response_matches_the_time_simulation(drive):
+@pytest.mark.parametrize("effects", [None, {"tyre_enveloping": {"length": 0.3}},
+                                     {"sensor": {"cutoff": 5.0, "acc_noise": 0.05, "disp_noise": 2e-4}}])
+def test_linear_response_matches_the_time_simulation(drive, effects):
     """On the nominal truck (a linear model: one linear solve per step) the linear time response
     over the simulator's own road reproduces the Exudyn simulation: RMS and rectified mean within
     1 % per channel and correlation > 0.999 (measured 0.1-0.3 % and >= 0.9998 on luliang: what is
     left is the integrator's numerical damping and second-order geometry; a missing rate input,
-    a wrong wheelbase delay or a wrong road grid each cost far more)."""
-    sim = make_truck_simulator(drive, channels=CH)(np.array([drive.time[0], drive.time[0] + 3.0,
-                                                             drive.time[-1]]))
+    a wrong wheelbase delay or a wrong road grid each cost far more).  Also with tyre enveloping
+    (the footprint filter on the road) and sensor dynamics and noise (the simulator's output hook,
+    same noise streams)."""
+    sim = make_truck_simulator(drive, channels=CH, effects=effects)(
+        np.array([drive.time[0], drive.time[0] + 3.0, drive.time[-1]]))
     P = np.array([[256e-6, 2.0, 0.05, 8.0], [64e-6, 2.3, 0.05, 8.0]])
     lin = LinearRealisation(sim)
     assert lin.left_out == []
@@ -42,6 +46,12 @@ def test_linear_response_matches_the_time_simulation(drive):
         assert np.std(b) == pytest.approx(np.std(a), rel=0.01), c
         assert np.mean(np.abs(b - b.mean())) == pytest.approx(np.mean(np.abs(a - a.mean())), rel=0.01), c
         assert np.corrcoef(a, b)[0, 1] > 0.999, c
+
+
+def test_nonlinear_effects_are_left_out_and_named(drive):
+    sim = make_truck_simulator(drive, channels=CH, effects={"leaf_friction": {"force": 2200.0}})(
+        np.array([drive.time[0], drive.time[-1]]))
+    assert LinearRealisation(sim).left_out == ["leaf_friction"]
 
 
 def test_mismatch_from_statistics_is_the_same_number():
