@@ -312,7 +312,12 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             summary["lateral"] = lateral
             write_table(table1(segs), tmp / "tables" / "table1",
                         note=table1_note(summary["fit_quality"]) + "\n\n" + note_line(summary["lateral"]))
-            write_table(table2(rows, sel["spread"]), tmp / "tables" / "table2", note=TABLE2_NOTE)
+            basis = ""
+            if sel["method"] == "linear":
+                basis = (f" Realisations: {sel['n_simulated']} of {len(seeds)} simulated in time, the others the "
+                         "linear truck's time response on the same road corrected by the mean log ratio "
+                         "simulated / linear of the simulated ones (tables/candidates.csv, column basis).")
+            write_table(table2(rows, sel["spread"]), tmp / "tables" / "table2", note=TABLE2_NOTE + basis)
             import pandas as pd
             pd.DataFrame([{"label": c["label"], "seed": c["seed"], "mismatch": c["mismatch"],
                            "basis": c.get("basis", "simulated"),
