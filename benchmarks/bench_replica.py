@@ -76,32 +76,37 @@ def iri_100(x, z, start) -> list:
     return [s.iri for s in iri_segments(x, z, 100.0, start=start)]
 
 
-def run_case(family: str, seed: int, cache: Path, holdout: bool) -> dict:
+def run_case(family: str, seed: int, cache: Path, holdout: bool, lines: str = "tyre", effects=None) -> dict:
     from drives.synth import synth_command
-    from vehicles.linear import linear_model
+    from inverse.linear_features import linear_model_for
+    from vehicles.effects import parse_effects
 
     ds = cache / f"{family}-{seed}"
     if not (ds / "truth" / "summary.json").is_file():
         synth_command(scenario=family, seed=seed, out=ds, force=True)
     drive = read_drive(ds)
-    lm = linear_model(drive.vehicle)
+    lm, left_out = linear_model_for(drive.vehicle, "rigid", parse_effects(effects) if effects else None)
     names = response_channels(drive.channel_names)
     chans = {c: drive.channels[c].to_numpy(float) for c in names}
     t0 = time.perf_counter()
-    rep = reconstruct(lm, drive.time, drive.speed, chans)
+    rep = reconstruct(lm, drive.time, drive.speed, chans, lines=lines)
     wall = time.perf_counter() - t0
     cov = rep.covered
     x = rep.x[cov]
     dx = float(rep.x[1] - rep.x[0])
     truth = true_tracks(ds, rep.x, lm.contacts)
-    case = {"family": family, "seed": seed, "wall_s": wall, "cg_iterations": rep.info["cg_iterations"],
+    case = {"family": family, "seed": seed, "wall_s": wall, "lines": lines, "effects": list(effects or []),
+            "effects_left_out": left_out, "cg_iterations": rep.info["cg_iterations"],
             "gd0_em": rep.gd0, "covered_m": float(x[-1] - x[0]),
             "band_at_speed_m": rep.info["band_at_speed_m"], "speed_quantiles_mps": rep.info["speed_quantiles_mps"]}
     for s, est in (("L", rep.z_left), ("R", rep.z_right)):
         zt = truth[s][cov]
         ze = est[cov]
         case[f"corr_{s}"] = band_correlation(ze, zt, dx, BAND)
-        case[f"corr_line_{s}"] = band_correlation(ze, truth[s + "_line"][cov], dx, BAND)
+        # the front tyre line: its own estimate where the replica has tyre lines
+        yf = next(c["y"] for c in lm.contacts if c["side"] == s)
+        zf = next((z for sd, y, z in rep.lines if sd == s and abs(y - yf) < 0.01), est) if lines == "tyre" else est
+        case[f"corr_line_{s}"] = band_correlation(zf[cov], truth[s + "_line"][cov], dx, BAND)
         start = float(x[0])
         ie, it = iri_100(x, ze, start), iri_100(x, zt, start)
         il = iri_100(x, truth[s + "_line"][cov], start)
@@ -112,7 +117,7 @@ def run_case(family: str, seed: int, cache: Path, holdout: bool) -> dict:
     if holdout:
         keep = [c for c in names if axle_of(c) != 2]
         held = [c for c in names if axle_of(c) == 2]
-        rep2 = reconstruct(lm, drive.time, drive.speed, {c: chans[c] for c in keep})
+        rep2 = reconstruct(lm, drive.time, drive.speed, {c: chans[c] for c in keep}, lines=lines)
         pred = rep2.predict(held)
         case["holdout_nrmse"] = {c: nrmse(pred[c], chans[c]) for c in held}
         c2 = rep2.covered
@@ -129,6 +134,12 @@ def summarise(cases: list) -> dict:
         line = np.array([[c["corr_line_L"], c["corr_line_R"]] for c in cc])
         err = np.concatenate([np.abs(c["iri100_relerr_L"] + c["iri100_relerr_R"]) for c in cc])
         ho = [v for c in cc for v in c.get("holdout_nrmse", {}).values()]
+        per_q = {}
+        for q in ("susp_disp", "axle_acc", "body_acc"):
+            v = [x for c in cc for k, x in c.get("holdout_nrmse", {}).items() if k.startswith(q)]
+            if v:
+                per_q[q] = {"median": float(np.median(v)), "max": float(max(v)),
+                            "within_0.3": f"{int(np.sum(np.array(v) <= 0.3))}/{len(v)}"}
         out[fam] = {"drives": len(cc), "corr_min": float(corr.min()), "corr_median": float(np.median(corr)),
                     "corr_line_min": float(line.min()), "corr_line_median": float(np.median(line)),
                     "iri100_abs_relerr_max": float(err.max()) if err.size else None,
@@ -137,22 +148,29 @@ def summarise(cases: list) -> dict:
                     "holdout_channels": len(ho),
                     "holdout_nrmse_max": float(max(ho)) if ho else None,
                     "holdout_nrmse_median": float(np.median(ho)) if ho else None,
+                    "holdout_within_0.3": f"{int(np.sum(np.array(ho) <= 0.3))}/{len(ho)}" if ho else None,
+                    "holdout_by_quantity": per_q,
                     "wall_s_median": float(np.median([c["wall_s"] for c in cc]))}
     return out
 
 
 def write_md(summary: dict, path: Path, command: str) -> None:
-    lines = ["# Road replica benchmark (issue 17)", "", f"Command: `{command}`", "",
+    lines = ["# Road replica benchmark", "", f"Command: `{command}`", "",
              "| family | drives | corr 0.5-20 m min / median | corr (front tyre line) min / median | "
              "IRI 100 m within 10 % | IRI rel. err. median / max | held-out nRMSE median / max (channels) | "
-             "wall s (median) |", "|---|---|---|---|---|---|---|---|"]
+             "held-out <= 0.3 | wall s (median) |", "|---|---|---|---|---|---|---|---|---|"]
     for fam, s in summary.items():
         ho = (f"{s['holdout_nrmse_median']:.3f} / {s['holdout_nrmse_max']:.3f} ({s['holdout_channels']})"
               if s["holdout_channels"] else "-")
         lines.append(f"| {fam} | {s['drives']} | {s['corr_min']:.3f} / {s['corr_median']:.3f} | "
                      f"{s['corr_line_min']:.3f} / {s['corr_line_median']:.3f} | {s['iri100_within_10pct']} | "
                      f"{s['iri100_abs_relerr_median']:.3f} / {s['iri100_abs_relerr_max']:.3f} | {ho} | "
-                     f"{s['wall_s_median']:.0f} |")
+                     f"{s.get('holdout_within_0.3') or '-'} | {s['wall_s_median']:.0f} |")
+    lines += ["", "Held-out nRMSE by quantity (axle 2 predicted from the replica of axles 1, 3, 4):", "",
+              "| family | quantity | median | max | <= 0.3 |", "|---|---|---|---|---|"]
+    for fam, s in summary.items():
+        for q, v in s.get("holdout_by_quantity", {}).items():
+            lines.append(f"| {fam} | {q} | {v['median']:.3f} | {v['max']:.3f} | {v['within_0.3']} |")
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -163,6 +181,10 @@ def main(argv=None) -> int:
     ap.add_argument("--holdout", type=int, default=3, help="drives per family with the axle-2 hold-out")
     ap.add_argument("--cache", default="/tmp/eroad-replica-bench", help="where the synthetic drives go")
     ap.add_argument("--out", default=str(ROOT / "results" / "replica"))
+    ap.add_argument("--lines", choices=("tyre", "track"), default="tyre", help="replica unknowns per side")
+    ap.add_argument("--effects", nargs="*", default=[], metavar="FAMILY:NAME=VALUE",
+                    help="effects given to the replica's linear model for one family's drives "
+                         "(e.g. random:frame_flex=1: what a diagnosis would name)")
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -172,7 +194,8 @@ def main(argv=None) -> int:
     from eroad.archive import finish_run_info, run_info, write_run_json
 
     record = run_info("replica_benchmark", run_id=out.name, command=command, seed=None,
-                      extra={"families": args.families, "holdout": args.holdout})
+                      extra={"families": args.families, "holdout": args.holdout, "lines": args.lines,
+                             "effects": args.effects})
     write_run_json(out, record)
     t_start = time.perf_counter()
     cases = []
@@ -181,7 +204,8 @@ def main(argv=None) -> int:
     for item in args.families:
         fam, _, n = item.partition(":")
         for seed in range(1, int(n or 1) + 1):
-            case = run_case(fam, seed, cache, holdout=seed <= args.holdout)
+            eff = [e.split(":", 1)[1] for e in args.effects if e.split(":", 1)[0] == fam]
+            case = run_case(fam, seed, cache, holdout=seed <= args.holdout, lines=args.lines, effects=eff)
             cases.append(case)
             with jl.open("a") as f:
                 f.write(json.dumps(case) + "\n")

@@ -174,3 +174,50 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return chosen
+
+
+def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: bool = False,
+                        force: bool = False, argv=None, diagnosis=None, progress=print, **replica) -> dict:
+    """``eroad replica DATASET --effects auto``: diagnose, then reconstruct the road with the
+    effect the diagnosis names (the same rule as :func:`invert_closed_loop`: only a
+    ``clear`` or identified verdict changes the model; otherwise the nominal one is used
+    and the reason is recorded).
+
+    Writes RUN (the replica's run folder, :func:`inverse.replica.run_replica`) with
+    ``RUN/diagnose/`` and ``summary.json`` ``closed_loop``.  ``diagnosis``: an existing
+    diagnosis run folder of this dataset to use instead of diagnosing again.
+    """
+    from diagnosis.pipeline import diagnose
+    from drives.format import swap_into_place, temp_folder_beside
+    from eroad.archive import write_json_atomic
+    from inverse.replica import run_replica
+    from inverse.run import check_out as _check_out
+
+    if "effects" in replica:
+        raise EroadInputError("--effects auto and explicit effect values cannot be combined")
+    out = Path(out)
+    _check_out(out, force)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    work = temp_folder_beside(out)
+    try:
+        if diagnosis is not None:
+            if not (Path(diagnosis) / "summary.json").is_file():
+                raise EroadInputError(f"{diagnosis}: not a diagnosis run folder (no summary.json)")
+            dsum = json.loads((Path(diagnosis) / "summary.json").read_text())
+            shutil.copytree(diagnosis, work / "diagnose")
+        else:
+            progress("closed loop: diagnosing the nominal model's gap ...")
+            dsum = diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed)
+        effects, reason = effects_from_diagnosis(dsum)
+        progress(f"closed loop: {reason}")
+        summary = run_replica(dataset, work / "replica", effects=effects, argv=argv, progress=progress, **replica)
+        main = work / "replica"
+        (work / "diagnose").rename(main / "diagnose")
+        summary["closed_loop"] = {"verdict": dsum.get("verdict"), "confidence": dsum.get("verdict_confidence"),
+                                  "effects": effects or {}, "corrected": bool(effects), "reason": reason,
+                                  "diagnosis": "diagnose/summary.json"}
+        write_json_atomic(main / "summary.json", summary)
+        swap_into_place(main, out)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return summary

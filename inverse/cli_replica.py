@@ -23,15 +23,20 @@ def register(subparsers) -> None:
                     "held out, and the road as .npz / .crg.")
     p.add_argument("dataset", help="dataset folder (drives format)")
     p.add_argument("--out", required=True, help="run folder to create")
-    p.add_argument("--effects", nargs="*", default=[], metavar="NAME=VALUE",
-                   help="effects of the vehicle model (linear ones enter the linear model; nonlinear ones "
-                        "such as leaf_friction are left out and listed in the summary)")
+    p.add_argument("--effects", nargs="*", default=[], metavar="NAME=VALUE|auto",
+                   help="effects of the vehicle model: linear ones enter the linear model, leaf_friction by "
+                        "statistical linearisation (equivalent damping from the measured suspension velocity), "
+                        "other nonlinear ones are left out and listed; 'auto': run the diagnosis first and use "
+                        "the effect it names with confidence (RUN/diagnose/)")
     p.add_argument("--noise", action="append", default=[], metavar="NAME=SD",
                    help="known white sensor noise (sd, SI unit) per channel or quantity, e.g. axle_acc=0.03; "
                         "repeatable; the rest is estimated from the top of each spectrum")
     p.add_argument("--holdout", default="2", metavar="AXLE|none",
                    help="axle whose channels are left out of a second reconstruction and predicted from it "
                         "(validation, shown in red in figures/replica_time.png; default 2; 'none' skips it)")
+    p.add_argument("--diagnosis", default=None, metavar="RUN",
+                   help="with --effects auto: an existing 'eroad diagnose' run folder of this dataset "
+                        "(otherwise the diagnosis runs first, about 2 minutes)")
     p.add_argument("--lines", choices=("tyre", "track"), default="tyre",
                    help="unknowns per side: a profile per lateral tyre position, coupled by the road's lateral "
                         "structure (default), or one track for all tyres of a side")
@@ -57,15 +62,21 @@ def _cmd_replica(args) -> int:
     from inverse.replica import run_replica
 
     effects = None
-    if args.effects:
-        if args.effects == ["auto"]:
-            raise EroadInputError("--effects auto is not implemented for eroad replica; give NAME=VALUE "
-                                  "(e.g. from 'eroad diagnose')")
-        from vehicles.effects import parse_effects
-        effects = parse_effects(args.effects)
-    summary = run_replica(args.dataset, args.out, effects=effects, noise_sd=_noise(args.noise), lines=args.lines,
-                          holdout=_holdout(args.holdout), force=args.force, argv=sys.argv,
-                          progress=lambda m: print(m, file=sys.stderr, flush=True))
+    say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
+    common = dict(noise_sd=_noise(args.noise), lines=args.lines, holdout=_holdout(args.holdout), force=args.force,
+                  argv=sys.argv, progress=say)
+    if "auto" in args.effects:
+        if args.effects != ["auto"]:
+            raise EroadInputError("--effects auto and NAME=VALUE effects cannot be combined")
+        from diagnosis.closed_loop import replica_closed_loop   # the closed loop sits above inverse
+        summary = replica_closed_loop(args.dataset, args.out, diagnosis=args.diagnosis, **common)
+    else:
+        if args.diagnosis:
+            raise EroadInputError("--diagnosis is used with --effects auto only")
+        if args.effects:
+            from vehicles.effects import parse_effects
+            effects = parse_effects(args.effects)
+        summary = run_replica(args.dataset, args.out, effects=effects, **common)
     if args.json:
         print(json.dumps(summary, indent=2))
         return 0
@@ -74,12 +85,18 @@ def _cmd_replica(args) -> int:
     ho = summary["holdout"]
     line = (f"wrote {args.out}: tracks over {summary['grid']['covered_m'][1] - summary['grid']['covered_m'][0]:.0f} m, "
             f"identified {band['median_lambda_min']:.2g}-{band['median_lambda_max']:.3g} m (median over the drive); "
-            f"IRI per 100 m left {', '.join(f'{v:.2f}' for v in iri['left_100m'])}, "
-            f"right {', '.join(f'{v:.2f}' for v in iri['right_100m'])} m/km")
+            + (f"IRI per 100 m left {', '.join(f'{v:.2f}' for v in iri['left_100m'])}, "
+               f"right {', '.join(f'{v:.2f}' for v in iri['right_100m'])} m/km" if iri["left_100m"]
+               else "no IRI per 100 m (under 100 m covered)"))
     if ho["channels"]:
         worst = max(ho["nrmse"].values())
         line += f"; axle {ho['axle']} held out: nRMSE <= {worst:.2f}"
     print(line + f" ({summary['timing']['total_s']:.0f} s wall)")
+    if "closed_loop" in summary:
+        print(f"closed loop: {summary['closed_loop']['reason']}")
+    for n in summary["linear_model"]["notes"]:
+        if "statistically linearised" in n:
+            print(f"note: {n}")
     left = summary["linear_model"]["effects_left_out"]
     if left:
         print(f"note: nonlinear effect(s) {', '.join(left)} left out of the linear model")

@@ -668,6 +668,58 @@ def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, d
                    info=info, operator=op, u=z, lines=op.line_heights(z))
 
 
+# --------------------------------------------------------------------------- the linear model
+#: low-pass before differentiating a suspension displacement for its velocity [Hz]
+#: (suspension motion lies below ~15 Hz; the sensor noise above would inflate the sd)
+VELOCITY_LOWPASS_HZ = 25.0
+
+
+def replica_linear_model(vehicle, effects, channels: dict, fs: float) -> tuple:
+    """The linear model of the replica with the given effects.
+
+    Linear effects enter as they are.  ``leaf_friction`` (nonlinear) enters by
+    STATISTICAL LINEARISATION (DECISION, docs/replica.md): for a Gaussian compression
+    velocity v of standard deviation s, the viscous damping that best replaces the
+    Coulomb force F sign(v) in the mean-square sense is c_eq = E[F sign(v) v] / E[v^2]
+    = F sqrt(2 / pi) / s (Roberts & Spanos, Random Vibration and Statistical
+    Linearization).  The effect's smoothed force F tanh(v / v0), linearised at rest as
+    the linear model does, is a damper F / v0; so the force handed to it is c_eq v0, with s
+    the RMS over the leaf-spring stations of the measured suspension velocity
+    (derivative of ``susp_disp_*``, low-passed at :data:`VELOCITY_LOWPASS_HZ`).  Other
+    nonlinear effects (bump stops, damper asymmetry) are left out, as in the linear fit.
+
+    Returns
+    -------
+    (LinearModel, left_out, notes) : the model, the effects left out, lines for the report.
+    """
+    from scipy.signal import butter, sosfiltfilt
+
+    from vehicles.effects import EFFECTS, resolve_effects
+    from vehicles.linear import linear_model
+    from vehicles.params import load_vehicle
+
+    vp = load_vehicle(vehicle)
+    eff = resolve_effects(effects) if effects else {}
+    keep = {k: dict(v) for k, v in eff.items() if not EFFECTS[k].nonlinear}
+    notes = []
+    if "leaf_friction" in eff and eff["leaf_friction"]["force"] > 0:
+        leaf_axles = {i + 1 for i, a in enumerate(vp.axles) if getattr(a, "spring_type", "") == "leaf"}
+        disp = [np.asarray(y, float) for c, y in channels.items()
+                if c.startswith("susp_disp_") and axle_of(c) in leaf_axles]
+        if disp:
+            sos = butter(4, min(VELOCITY_LOWPASS_HZ, 0.4 * fs), fs=fs, output="sos")
+            vel = [np.gradient(sosfiltfilt(sos, d - d.mean())) * fs for d in disp]
+            s = float(np.sqrt(np.mean([np.mean(v ** 2) for v in vel])))
+            p = dict(eff["leaf_friction"])
+            c_eq = p["force"] / max(p["velocity"], s * math.sqrt(math.pi / 2.0))
+            keep["leaf_friction"] = {"force": c_eq * p["velocity"], "velocity": p["velocity"]}   # F'/v0 = c_eq
+            notes.append(f"leaf_friction {p['force']:.0f} N statistically linearised: suspension velocity "
+                         f"RMS {s * 1e3:.0f} mm/s -> damping {c_eq:.0f} N s/m per spring")
+    left = sorted(set(eff) - set(keep))
+    ordered = {k: keep[k] for k in eff if k in keep}
+    return linear_model(vp, "rigid", effects=ordered or None), left, notes
+
+
 # --------------------------------------------------------------------------- scoring helpers
 def band_filter(z, dx: float, band_m=(0.5, 20.0)) -> np.ndarray:
     """Profile band-passed to wavelengths within ``band_m`` [m] (FFT mask, mean and
@@ -791,7 +843,6 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
     import pandas as pd
 
     from drives.format import read_drive, swap_into_place, temp_folder_beside
-    from inverse.linear_features import linear_model_for
     from roadlib.iri import iri_segments
     from roadlib.metrics import fit_iso_psd, profile_psd
     from eroad.archive import finish_run_info, run_info, write_json_atomic, write_run_json
@@ -811,7 +862,8 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
                               f"{', '.join(drive.channel_names) or 'none'}")
     if not np.all(np.asarray(drive.speed) > 0.5):
         raise EroadInputError(f"{drive.path}: eroad replica needs a moving vehicle (speed > 0.5 m/s throughout)")
-    lm, left_out = linear_model_for(drive.vehicle, "rigid", effects)
+    chans = {c: drive.channels[c].to_numpy(float) for c in names}
+    lm, left_out, lin_notes = replica_linear_model(drive.vehicle, effects, chans, drive.sample_rate_hz)
     missing = [c for c in names if c not in lm.channel_names]
     if missing:
         raise EroadInputError(f"{drive.path}: channel(s) {', '.join(missing)} have no counterpart in "
@@ -821,7 +873,6 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         from inverse.cli import noise_psd_from_sd
         psd = noise_psd_from_sd(noise_sd, names, drive.sample_rate_hz)
         noise = {c: math.sqrt(p * 0.5 * drive.sample_rate_hz) for c, p in psd.items()}
-    chans = {c: drive.channels[c].to_numpy(float) for c in names}
     if lines not in LINE_MODES:
         raise EroadInputError(f"--lines {lines!r}: use one of {', '.join(LINE_MODES)}")
     rep = reconstruct(lm, drive.time, drive.speed, chans, noise=noise, progress=progress, lines=lines)
@@ -832,7 +883,9 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         if not held or not keep:
             raise EroadInputError(f"--holdout {holdout}: the drive has no channels of axle {holdout}, or "
                                   f"only those")
-        rep2 = reconstruct(lm, drive.time, drive.speed, {c: chans[c] for c in keep}, noise=noise,
+        lm2 = lm if not lin_notes else replica_linear_model(      # no held-out data in the linearisation
+            drive.vehicle, effects, {c: chans[c] for c in keep}, drive.sample_rate_hz)[0]
+        rep2 = reconstruct(lm2, drive.time, drive.speed, {c: chans[c] for c in keep}, noise=noise,
                            progress=progress, lines=lines)
         pred = rep2.predict(held)
     dx = float(rep.x[1] - rep.x[0])
@@ -854,6 +907,9 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         iri = {}
         for side, z in (("left", rep.z_left), ("right", rep.z_right)):
             for L in (20.0, 100.0):
+                if xc[-1] - xc[0] < L:          # a drive shorter than the segment: no IRI of that length
+                    iri[f"{side}_{int(L)}m"] = []
+                    continue
                 segs = iri_segments(xc, z[cov], L, start=float(xc[0]))
                 rows += [{"track": side, "segment_m": L, "start_m": s.start, "end_m": s.end,
                           "iri_m_per_km": s.iri} for s in segs]
@@ -906,7 +962,8 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
                         "nrmse_definition": "RMS(pred - meas) / RMS(meas), means removed"},
             "iri_m_per_km": iri,
             "psd_iso_fit": fits,
-            "linear_model": {"effects_left_out": left_out, "notes": rep.info["linear_model_notes"]},
+            "linear_model": {"effects": {k: dict(v) for k, v in lm.meta.get("effects", {}).items()},
+                             "effects_left_out": left_out, "notes": rep.info["linear_model_notes"] + lin_notes},
             "figures": figs,
             "files": ["tracks.csv", "iri.csv", "psd.csv", "road.npz", "road.crg"],
             "timing": {"reconstruct_s": rep.info["wall_s"],
