@@ -133,7 +133,8 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     try:
         if diagnosis is not None:
             dsum = json.loads((Path(diagnosis) / "summary.json").read_text())
-            shutil.copytree(diagnosis, work / "diagnose")
+            if copy_diagnosis:
+                shutil.copytree(diagnosis, work / "diagnose")
         else:
             progress("closed loop: diagnosing the nominal model's gap ...")
             dsum = diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed)
@@ -177,7 +178,8 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
 
 
 def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: bool = False,
-                        force: bool = False, argv=None, diagnosis=None, progress=print, **replica) -> dict:
+                        force: bool = False, argv=None, diagnosis=None, copy_diagnosis: bool = True,
+                        progress=print, **replica) -> dict:
     """``eroad replica DATASET --effects auto``: diagnose, then reconstruct the road with the
     effect the diagnosis names (the same rule as :func:`invert_closed_loop`: only a
     ``clear`` or identified verdict changes the model; otherwise the nominal one is used
@@ -204,7 +206,8 @@ def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick:
             if not (Path(diagnosis) / "summary.json").is_file():
                 raise EroadInputError(f"{diagnosis}: not a diagnosis run folder (no summary.json)")
             dsum = json.loads((Path(diagnosis) / "summary.json").read_text())
-            shutil.copytree(diagnosis, work / "diagnose")
+            if copy_diagnosis:
+                shutil.copytree(diagnosis, work / "diagnose")
         else:
             progress("closed loop: diagnosing the nominal model's gap ...")
             dsum = diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed)
@@ -212,11 +215,24 @@ def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick:
         progress(f"closed loop: {reason}")
         summary = run_replica(dataset, work / "replica", effects=effects, argv=argv, progress=progress, **replica)
         main = work / "replica"
-        (work / "diagnose").rename(main / "diagnose")
+        if (work / "diagnose").is_dir():
+            (work / "diagnose").rename(main / "diagnose")
+            where = "diagnose/summary.json"
+        else:
+            import os
+            where = os.path.relpath(Path(diagnosis).resolve() / "summary.json", out.resolve())
         summary["closed_loop"] = {"verdict": dsum.get("verdict"), "confidence": dsum.get("verdict_confidence"),
                                   "effects": effects or {}, "corrected": bool(effects), "reason": reason,
-                                  "diagnosis": "diagnose/summary.json"}
+                                  "diagnosis": where}
+        from inverse.run import dataset_path
+        summary["dataset"]["path"] = dataset_path(dataset, out)      # as recorded from the final folder
         write_json_atomic(main / "summary.json", summary)
+        import tomllib
+
+        import tomli_w
+        cfg = tomllib.loads((main / "config.toml").read_text())
+        cfg["dataset"] = summary["dataset"]["path"]
+        (main / "config.toml").write_text(tomli_w.dumps(cfg))
         swap_into_place(main, out)
     finally:
         shutil.rmtree(work, ignore_errors=True)

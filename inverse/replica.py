@@ -843,6 +843,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
     import pandas as pd
 
     from drives.format import read_drive, swap_into_place, temp_folder_beside
+    from inverse.run import dataset_path
     from roadlib.iri import iri_segments
     from roadlib.metrics import fit_iso_psd, profile_psd
     from eroad.archive import finish_run_info, run_info, write_json_atomic, write_run_json
@@ -936,7 +937,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         fit_scores = {c: nrmse(rep.fitted[c], chans[c]) for c in names}
         summary = {
             "format": RUN_FORMAT,
-            "dataset": {"name": drive.name, "path": str(Path(dataset).resolve()), "vehicle": str(drive.vehicle),
+            "dataset": {"name": drive.name, "path": dataset_path(dataset, out), "vehicle": str(drive.vehicle),
                         "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz,
                         "warnings": list(drive.warnings)},
             "method": "time-domain MAP input estimation on the linear model (docs/replica.md)",
@@ -973,7 +974,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         }
         write_json_atomic(tmp / "summary.json", summary)
         import tomli_w
-        cfg = {"dataset": str(Path(dataset).resolve()), "effects": json.dumps(effects or {}),
+        cfg = {"dataset": dataset_path(dataset, out), "effects": json.dumps(effects or {}),
                "noise_sd": dict(noise_sd or {}), "holdout": -1 if holdout is None else int(holdout),
                "dx_m": dx, "substeps": rep.info["substeps"], "runin_s": rep.info["runin_s"], "lines": lines}
         (tmp / "config.toml").write_text(tomli_w.dumps(cfg))

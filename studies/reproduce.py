@@ -15,6 +15,7 @@ step        paper items                             code
 dataset     (input)                                 drives.synth.default_dataset
 fig4_5      Figures 4, 5                            drives.figures.plot_figures
 invert      Figures 6, 8, 9; Tables 1, 2; road      diagnosis.closed_loop.invert_closed_loop
+replica     Figure 8 on the reconstructed road      diagnosis.closed_loop.replica_closed_loop
 figure11    Figure 11 and the findings table        studies.figure11.run_figure11
 chassis     chassis-stiffness study                 studies.chassis_study.run_chassis_study
 diagnose    sim-to-real gap of the dataset          (the invert step's diagnosis, copied)
@@ -43,6 +44,9 @@ MANIFEST = [
     ("Figure 6", "invert", "figures/figure6_segmentation.png", "inverse.run.run_inversion"),
     ("Table 1", "invert", "tables/table1.md", "inverse.run.run_inversion"),
     ("Figure 8", "invert", "figures/figure8_time_compare.png", "inverse.run.run_inversion"),
+    ("Figure 8 on the road replica",
+     "replica", "figures/replica_time.png", "inverse.replica.run_replica"),
+    ("Road replica: wheel-track profiles, IRI, .crg", "replica", "tracks.csv", "inverse.replica.run_replica"),
     ("Figure 9", "invert", "figures/figure9_amplitude_distributions.png", "inverse.run.run_inversion"),
     ("Table 2", "invert", "tables/table2.md", "inverse.run.run_inversion"),
     ("Global road (section 2.5)", "invert", "road.*", "inverse.run.run_inversion"),
@@ -103,6 +107,17 @@ def _step_invert(run: Path, quick: bool, workers: int, log) -> dict:
 
     return _jsonable(invert_closed_loop(run / "dataset", run / "invert", quick=quick, workers=workers,
                                         seed=0, argv=sys.argv, progress=log))
+
+
+def _step_replica(run: Path, quick: bool, workers: int, log) -> dict:
+    """Figure 8 on the measured road's own time history: the road replica (inverse.replica)
+    with the effect the invert step's diagnosis named (the same closed-loop rule)."""
+    from diagnosis.closed_loop import replica_closed_loop
+
+    made = run / "invert" / "diagnose"
+    diag = made if (made / "summary.json").is_file() else None
+    return _jsonable(replica_closed_loop(run / "dataset", run / "replica", diagnosis=diag, copy_diagnosis=False,
+                                         workers=workers, quick=quick, seed=0, argv=sys.argv, progress=log))
 
 
 def _identified_road(run: Path) -> Path:
@@ -180,7 +195,7 @@ def _step_diagnose(run: Path, quick: bool, workers: int, log) -> dict:
 
 
 STEPS = [("dataset", _step_dataset), ("fig4_5", _step_fig4_5), ("invert", _step_invert),
-         ("figure11", _step_figure11), ("chassis", _step_chassis), ("diagnose", _step_diagnose)]
+         ("replica", _step_replica), ("figure11", _step_figure11), ("chassis", _step_chassis), ("diagnose", _step_diagnose)]
 
 
 def _jsonable(obj):
