@@ -316,6 +316,18 @@ def line_weights(blocks, alpha: float, dx: float = DX) -> np.ndarray:
     return np.array([0.0 if b["kind"] == "track" else alpha * dx / b["dy"] for b in blocks])
 
 
+def side_tracks(op, u) -> dict:
+    """The wheel track of each side: the mean of the road under that side's tyres (every
+    tyre counted once, so a dual pair weighs twice), from the unknowns ``u``; with
+    ``lines="track"`` the track itself."""
+    U = np.asarray(u, float).reshape(op.n_blocks, op.n_grid)
+    out = {}
+    for side in ("L", "R"):
+        rows = [U[bs].sum(axis=0) for c, bs in zip(op.lm.contacts, op.blocks_of) if c["side"] == side]
+        out[side] = np.mean(rows, axis=0)
+    return out
+
+
 def first_difference(N: int) -> sps.csr_matrix:
     """First difference of each of the two tracks, (2(N-1), 2N)."""
     d = sps.diags([-np.ones(N - 1), np.ones(N - 1)], [0, 1], shape=(N - 1, N))
@@ -395,7 +407,7 @@ class Replica:
     x : (N,) array
         Distance [m] (0: first axle at the first sample).
     z_left, z_right : (N,) arrays
-        Track heights [m].
+        Track heights [m]: the mean of the road under each side's tyres (:func:`side_tracks`).
     covered : (N,) bool
         Grid points a tyre ran over during the record.
     lambda_min, lambda_max : (N,) arrays
@@ -661,7 +673,8 @@ def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, d
             "linear_model_notes": list(lm.meta.get("notes", []))}
     info["lines"] = lines
     info["line_blocks"] = [{k: v for k, v in b.items()} for b in op.blocks]
-    return Replica(x=op.x, z_left=z[:N].copy(), z_right=z[N:2 * N].copy(), covered=op.covered,
+    tracks = side_tracks(op, z)
+    return Replica(x=op.x, z_left=tracks["L"], z_right=tracks["R"], covered=op.covered,
                    lambda_min=lam_min, lambda_max=lam_max, channels=names,
                    sigma=dict(zip(names, sig.tolist())), sigma_sensor=sensor, alpha=al,
                    gd0=gd0_of_alpha(al, dx), fitted={c: fitted[k] + 0.0 for k, c in enumerate(names)},
