@@ -212,6 +212,7 @@ def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick:
             progress("closed loop: diagnosing the nominal model's gap ...")
             dsum = diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed)
         effects, reason = effects_from_diagnosis(dsum)
+        reason = reason.replace("; inverted with", "; reconstructed with")
         progress(f"closed loop: {reason}")
         summary = run_replica(dataset, work / "replica", effects=effects, argv=argv, progress=progress, **replica)
         main = work / "replica"
