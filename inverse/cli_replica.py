@@ -37,6 +37,9 @@ def register(subparsers) -> None:
     p.add_argument("--diagnosis", default=None, metavar="RUN",
                    help="with --effects auto: an existing 'eroad diagnose' run folder of this dataset "
                         "(otherwise the diagnosis runs first, about 2 minutes)")
+    p.add_argument("--inversion", default=None, metavar="RUN",
+                   help="an 'eroad invert' run folder of this dataset: compare each segment's fitted PSD with "
+                        "the replica's (figures/replica_vs_inversion.png, psd_segments.csv)")
     p.add_argument("--lines", choices=("tyre", "track"), default="tyre",
                    help="unknowns per side: a profile per lateral tyre position, coupled by the road's lateral "
                         "structure (default), or one track for all tyres of a side")
@@ -63,7 +66,7 @@ def _cmd_replica(args) -> int:
 
     effects = None
     say = lambda m: print(m, file=sys.stderr, flush=True)  # noqa: E731
-    common = dict(noise_sd=_noise(args.noise), lines=args.lines, holdout=_holdout(args.holdout), force=args.force,
+    common = dict(noise_sd=_noise(args.noise), lines=args.lines, inversion=args.inversion, holdout=_holdout(args.holdout), force=args.force,
                   argv=sys.argv, progress=say)
     if "auto" in args.effects:
         if args.effects != ["auto"]:

@@ -761,6 +761,85 @@ def nrmse(pred, meas) -> float:
     return float(np.sqrt(np.mean((p - m) ** 2)) / np.sqrt(np.mean(m ** 2)))
 
 
+# --------------------------------------------------------------------------- against the inversion
+def inversion_segment_psd(seg: dict, n) -> np.ndarray:
+    """The PSD [m^3] an inversion segment (summary.json row) reports at ``n`` [cycles/m]:
+    its two-slope refit where the road model chose two slopes, else the one-slope fit."""
+    from roadlib.psd import iso_psd, two_slope_psd
+
+    n = np.asarray(n, float)
+    if seg.get("road_model") == "two_slope":
+        two = (seg.get("road_model_fit") or {}).get("two_slope", {})
+        return two_slope_psd(n, two["Gq_n0_low_line"], seg["w_low"], seg["w_high"], seg["n_break"])
+    return iso_psd(n, seg["Gq_n0"], seg["w"])
+
+
+def segment_psd_rows(rep: Replica, time, segments: list, band_m=(0.5, 20.0)) -> list:
+    """Per inversion segment: the replica's PSD over the stretch axle 1 drove during the
+    segment (both tracks' periodograms averaged, Welch segments of at most 1/4 of it)
+    against the inversion's fitted PSD there.
+
+    Returns a list of dicts: segment, t_start, t_end [s], x_start, x_end [m], the
+    replica PSD (``n``, ``G``), the fitted PSD on the same ``n``, and the mean log ratio
+    replica / fit over ``band_m`` and the segment's own band (``ln_ratio``, [-];
+    nan where under 3 Welch bins fall in it).
+    """
+    from roadlib.metrics import profile_psd
+
+    t = np.asarray(time, float)
+    s_rec = rep.operator.s_record
+    dx = float(rep.x[1] - rep.x[0])
+    rows = []
+    for k, seg in enumerate(segments):
+        x0, x1 = np.interp([seg["t_start"], seg["t_end"]], t, s_rec)
+        m = (rep.x >= x0) & (rep.x <= x1)
+        if m.sum() < 64:
+            continue
+        est = profile_psd(np.stack([rep.z_left[m], rep.z_right[m]], axis=1), dx,
+                          nperseg=int(2 ** math.floor(math.log2(max(32, m.sum() // 4)))))
+        n, G = est.n[1:], est.G[1:]
+        fit = inversion_segment_psd(seg, n)
+        lo = max(1.0 / band_m[1], seg.get("nmin", 0.0))
+        hi = min(1.0 / band_m[0], seg.get("nmax", np.inf))
+        sel = (n >= lo) & (n <= hi)
+        lr = float(np.mean(np.log(G[sel] / fit[sel]))) if sel.sum() >= 3 else float("nan")
+        rows.append({"segment": k + 1, "t_start": float(seg["t_start"]), "t_end": float(seg["t_end"]),
+                     "x_start": float(x0), "x_end": float(x1), "n": n, "G": G, "fit": fit,
+                     "band": (float(lo), float(hi)), "ln_ratio": lr,
+                     "road_model": seg.get("road_model", "one_slope"), "class": seg.get("class")})
+    return rows
+
+
+def plot_segment_psd(rows: list, path, title: str = "") -> None:
+    """One panel per segment: replica PSD against the inversion's fitted PSD."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    k = max(1, len(rows))
+    cols = min(k, 3)
+    nr = int(math.ceil(k / cols))
+    fig, axes = plt.subplots(nr, cols, figsize=(4.2 * cols, 3.4 * nr + 0.6), squeeze=False)
+    for ax, r in zip(axes.ravel(), rows):
+        ax.loglog(r["n"], r["G"], "C0", lw=1.0, label="replica (both tracks)")
+        ax.loglog(r["n"], r["fit"], "k--", lw=1.2,
+                  label=f"inversion fit ({r['road_model'].replace('_', ' ')}, class {r['class']})")
+        ax.axvspan(*r["band"], color="0.92", zorder=0)
+        ax.set_title(f"segment {r['segment']}: {r['t_start']:.1f}-{r['t_end']:.1f} s, "
+                     f"{r['x_end'] - r['x_start']:.0f} m\nmean ln(replica / fit) in grey band "
+                     f"{r['ln_ratio']:+.2f}", fontsize=8)
+        ax.set_xlabel("n [cycles/m]", fontsize=8)
+        ax.set_ylabel("Gd(n) [m^3]", fontsize=8)
+        ax.legend(fontsize=7, loc="lower left")
+    for ax in axes.ravel()[len(rows):]:
+        ax.axis("off")
+    fig.suptitle(f"Replica against the statistical inversion, per segment {title}\n"
+                 "grey: the segment's fitted band within 0.5-20 m", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 # --------------------------------------------------------------------------- the run folder
 #: run-folder format version of ``eroad replica``
 RUN_FORMAT = 1
@@ -821,7 +900,7 @@ def replica_surface(rep: Replica):
 
 
 def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: bool = False,
-                argv=None, progress=None, lines: str = "tyre") -> dict:
+                argv=None, progress=None, lines: str = "tyre", inversion=None) -> dict:
     """``eroad replica``: reconstruct, score the hold-out, write the run folder.
 
     RUN (written into a temporary sibling folder and renamed into place, like
@@ -848,8 +927,12 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         from it (validation); None: none.
     lines : {"tyre", "track"}
         Unknowns per side: a line per lateral tyre position (default) or one track.
+    inversion : str or Path, optional
+        An ``eroad invert`` run folder of the same dataset: its segments' fitted PSDs are
+        compared with the replica's (psd_segments.csv, figures/replica_vs_inversion.png).
     """
     import json
+    import os
     import shutil
     from pathlib import Path
 
@@ -942,10 +1025,30 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
                 fits[side] = fit_iso_psd(e, band=band).to_dict()
             except EroadInputError as exc:
                 fits[side] = {"error": str(exc)}
+        seg_rows, inv_info = [], None
+        if inversion is not None:
+            inv_sum = Path(inversion) / "summary.json"
+            if not inv_sum.is_file():
+                raise EroadInputError(f"--inversion {inversion}: not an 'eroad invert' run folder (no summary.json)")
+            inv = json.loads(inv_sum.read_text())
+            seg_rows = segment_psd_rows(rep, drive.time, inv.get("segments", []))
+            pd.DataFrame([{"segment": r["segment"], "t_start_s": r["t_start"], "t_end_s": r["t_end"],
+                           "n_cpm": n, "G_replica_m3": g, "G_inversion_m3": f}
+                          for r in seg_rows for n, g, f in zip(r["n"], r["G"], r["fit"])]).to_csv(
+                tmp / "psd_segments.csv", index=False, float_format="%.6g")
+            if seg_rows:
+                plot_segment_psd(seg_rows, tmp / "figures" / "replica_vs_inversion.png", title=drive.name)
+            inv_info = {"run": os.path.relpath(Path(inversion).resolve(), Path(out).resolve()),
+                        "segments": [{k: r[k] for k in ("segment", "t_start", "t_end", "x_start", "x_end",
+                                                        "road_model", "class", "ln_ratio")} for r in seg_rows],
+                        "ln_ratio_meaning": "mean ln(replica PSD / inversion PSD) over the segment's band "
+                                            "within 0.5-20 m; 0: the two methods agree"}
         surf = replica_surface(rep)
         surf.save(tmp / "road.npz")
         surf.save(tmp / "road.crg")
         figs = write_replica_figures(tmp / "figures", drive, rep, est, est_r, fits, held, pred, title=drive.name)
+        if seg_rows:
+            figs.append("replica_vs_inversion.png")
         holdout_scores = {c: nrmse(pred[c], chans[c]) for c in held}
         fit_scores = {c: nrmse(rep.fitted[c], chans[c]) for c in names}
         summary = {
@@ -976,10 +1079,12 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
                         "nrmse_definition": "RMS(pred - meas) / RMS(meas), means removed"},
             "iri_m_per_km": iri,
             "psd_iso_fit": fits,
+            "against_inversion": inv_info,
             "linear_model": {"effects": {k: dict(v) for k, v in lm.meta.get("effects", {}).items()},
                              "effects_left_out": left_out, "notes": rep.info["linear_model_notes"] + lin_notes},
             "figures": figs,
-            "files": ["tracks.csv", "iri.csv", "psd.csv", "road.npz", "road.crg"],
+            "files": ["tracks.csv", "iri.csv", "psd.csv", "road.npz", "road.crg"]
+                     + (["psd_segments.csv"] if inversion is not None else []),
             "timing": {"reconstruct_s": rep.info["wall_s"],
                        "holdout_s": rep2.info["wall_s"] if rep2 is not None else 0.0,
                        "cg_iterations": rep.info["cg_iterations"],

@@ -47,6 +47,8 @@ MANIFEST = [
     ("Figure 8 on the road replica",
      "replica", "figures/replica_time.png", "inverse.replica.run_replica"),
     ("Road replica: wheel-track profiles, IRI, .crg", "replica", "tracks.csv", "inverse.replica.run_replica"),
+    ("Road replica against the inversion, per segment", "replica", "figures/replica_vs_inversion.png",
+     "inverse.replica.run_replica"),
     ("Figure 9", "invert", "figures/figure9_amplitude_distributions.png", "inverse.run.run_inversion"),
     ("Table 2", "invert", "tables/table2.md", "inverse.run.run_inversion"),
     ("Global road (section 2.5)", "invert", "road.*", "inverse.run.run_inversion"),
@@ -116,8 +118,10 @@ def _step_replica(run: Path, quick: bool, workers: int, log) -> dict:
 
     made = run / "invert" / "diagnose"
     diag = made if (made / "summary.json").is_file() else None
+    inv = run / "invert" if (run / "invert" / "summary.json").is_file() else None
     return _jsonable(replica_closed_loop(run / "dataset", run / "replica", diagnosis=diag, copy_diagnosis=False,
-                                         workers=workers, quick=quick, seed=0, argv=sys.argv, progress=log))
+                                         inversion=inv, workers=workers, quick=quick, seed=0, argv=sys.argv,
+                                         progress=log))
 
 
 def _identified_road(run: Path) -> Path:

@@ -317,3 +317,35 @@ def test_statistical_linearisation_of_leaf_friction():
     assert abs(got / c_eq - 1) < 0.01
     eff = lm.meta["effects"]["leaf_friction"]
     assert abs(eff["force"] / eff["velocity"] / c_eq - 1) < 0.01
+
+
+def test_segment_psd_against_an_inversion_agrees_on_a_known_profile():
+    # a replica whose tracks ARE an ISO profile of known level and waviness, driven at
+    # 10 m/s, compared with "inversion segments" carrying the same parameters: the mean
+    # log ratio over each segment's band is ~0.  Tolerance 0.3: over 6 seeds the mean log
+    # ratio of 100-150 m stretches (two tracks, ~7 half-overlapping Welch windows) was
+    # -0.11..+0.08; a level wrong by a factor 1.5 (0.41) or w wrong by 0.3 (0.3-0.5 over
+    # the band) fails.  The two-slope row uses the two-slope formula.
+    from types import SimpleNamespace
+
+    from inverse.replica import inversion_segment_psd, segment_psd_rows
+    from roadlib.psd import two_slope_psd
+    from roadlib.synthesis import SpectralParams, synth_profile
+
+    p = SpectralParams(Gq_n0=64e-6, w=2.0, nmin=0.02, nmax=5.0, dx=0.1)
+    x, zl = synth_profile(p, 400.0, seed=3)
+    _, zr = synth_profile(p, 400.0, seed=4)
+    t = np.arange(0, 40.0, 0.01)
+    rep = SimpleNamespace(x=x, z_left=zl, z_right=zr, operator=SimpleNamespace(s_record=10.0 * t))
+    segs = [{"t_start": 0.0, "t_end": 15.0, "Gq_n0": 64e-6, "w": 2.0, "nmin": 0.05, "nmax": 2.0, "class": "C"},
+            {"t_start": 15.0, "t_end": 25.0, "Gq_n0": 64e-6, "w": 2.0, "nmin": 0.05, "nmax": 2.0, "class": "C"},
+            {"t_start": 25.0, "t_end": 39.0, "Gq_n0": 64e-6 * 1.5, "w": 2.0, "nmin": 0.05, "nmax": 2.0}]
+    rows = segment_psd_rows(rep, t, segs)
+    assert [r["segment"] for r in rows] == [1, 2, 3]
+    assert abs(rows[0]["ln_ratio"]) < 0.3 and abs(rows[1]["ln_ratio"]) < 0.3
+    assert rows[2]["ln_ratio"] < -0.1                      # the fit 1.5x too high shows
+    assert abs(rows[1]["x_end"] - 250.0) < 1e-9
+    two = {"road_model": "two_slope", "w_low": 2.5, "w_high": 1.5, "n_break": 0.3,
+           "road_model_fit": {"two_slope": {"Gq_n0_low_line": 1e-4}}}
+    n = np.array([0.05, 0.3, 2.0])
+    assert np.allclose(inversion_segment_psd(two, n), two_slope_psd(n, 1e-4, 2.5, 1.5, 0.3))
