@@ -1,6 +1,6 @@
 """Chassis-stiffness study in contact-force terms (studies.pantograph_chassis).
 
-A tiny study (frame factors 0.25 and rigid, nominal mounts, a 4 s drive at 80 km/h on
+A tiny study (frame factors 1 and rigid, nominal mounts, a 4 s drive at 80 km/h on
 the identified road of the committed reference run, serial) checks the table's columns,
 the run folder and these physical properties, each of which can fail:
 
@@ -37,20 +37,20 @@ def tiny(tmp_path_factory):
     if not ROAD.is_file():
         pytest.skip("reference road not in this checkout")
     out = tmp_path_factory.mktemp("pc")
-    s = run_pantograph_chassis(ROAD, out, run_dir=out / "run", frames=(0.25, "rigid"),
+    s = run_pantograph_chassis(ROAD, out, run_dir=out / "run", frames=(1.0, "rigid"),
                                mounts=(1.0,), duration=4.0, n_workers=0,
                                cache_dir=out / "cache", progress=False, command=["test"])
-    return s, pd.read_csv(out / "run" / "data" / "table.csv", dtype={"frame": str})
+    return s, pd.read_csv(out / "run" / "data" / "table.csv", dtype={"frame": str}), out
 
 
 def test_table_columns_and_run_folder(tiny):
-    s, t = tiny
+    s, t, _ = tiny
     run = Path(s["path"])
     assert list(t.columns) == list(TABLE_COLUMNS)
     assert list(t["base"]) == ["drive", "drive", "still"]
-    assert list(t["frame"]) == ["0.25", "rigid", "-"]
+    assert list(t["frame"]) == ["1.0", "rigid", "-"]
     md = (run / "data" / "table.md").read_text()
-    assert md.count("| 0.25 | 1 |") == 2 and "| base still |" in md
+    assert md.count("| 1.0 | 1 |") == 2 and "| base still |" in md
     for name in ("run.json", "summary.json", "config.toml", "figures/contact_vs_stiffness.png",
                  "data/forces.npz"):
         assert (run / name).is_file(), name
@@ -60,7 +60,7 @@ def test_table_columns_and_run_folder(tiny):
 
 
 def test_base_excitation_adds_to_the_sd(tiny):
-    _, t = tiny
+    _, t, _ = tiny
     still = t[t["base"] == "still"].iloc[0]
     drive = t[t["base"] == "drive"]
     assert still["base_induced_sd_N"] == 0.0
@@ -75,20 +75,27 @@ def test_base_excitation_adds_to_the_sd(tiny):
 
 
 def test_base_acts_through_the_lower_damper(tiny):
-    _, t = tiny
+    _, t, _ = tiny
     drive = t[t["base"] == "drive"]
     ratio = drive["dF_rms_0.5-5Hz_N"] / (1e-3 * drive["vz_rms_0.5-5Hz_mm_s"])
     assert ((ratio > 0.5 * 70.0) & (ratio < 70.0)).all(), ratio.tolist()
 
 
-def test_contact_force_linear_in_base_motion():
-    if not ROAD.is_file():
-        pytest.skip("reference road not in this checkout")
+def test_contact_force_linear_in_base_motion(tiny):
     from studies.chassis_study import road_specs
+    from studies.pantograph_chassis import code_version
+    from studies.sweep import run_cases
 
+    out = tiny[2]
     spec = road_specs(ROAD, n_seeds=0)[0][0]
-    case = study_cases(spec, frames=(1.0,), mounts=(1.0,), duration=4.0)[0]
-    f = {k: contact_case({**case, "base_scale": k})["force"] for k in (0.0, 1.0, 2.0)}
+    cases = study_cases(spec, frames=(1.0, "rigid"), mounts=(1.0,), duration=4.0)
+    # the study's cases (frame 1 with base scale 1, and the still base) from its cache,
+    # in float64; only the doubled base motion is computed here
+    sw = run_cases(contact_case, cases, cache_dir=out / "cache", n_workers=0,
+                   progress=False, code_version=code_version())
+    assert sw.n_cached == len(cases)
+    f = {1.0: sw.results[0]["force"], 0.0: sw.results[-1]["force"],
+         2.0: contact_case({**cases[0], "base_scale": 2.0})["force"]}
     assert f[1.0].min() > 0 and f[2.0].min() > 0  # the contact never opens
     d1, d2 = f[1.0] - f[0.0], f[2.0] - f[0.0]
     assert np.max(np.abs(d1)) > 0.1
