@@ -24,7 +24,9 @@ one, the 16/50/84 % points of the spread (Table 2's headline) from both, and bot
 selections' simulated statistic.
 
 Wall times: ``total`` = the whole ``run_inversion``, ``fit`` = segmentation and fit,
-``sel`` = the realisation selection, ``report`` = tables, figures, road.  Ratio printed:
+``selection`` = the realisation selection (with a pool the road model and the lateral summary
+run beside it), ``report`` = the wall after the selection; ``CPU`` = CPU seconds of the run
+(this process and its pool workers): a free 2-core machine needs at least half of it.  Ratio printed:
 total ``sim/sim`` over ``lin/lin`` (and ``lin/sim`` over ``lin/lin``), measured in the same run.
 
 Run:  nice python benchmarks/bench_inverse_speed.py [--null-seeds 1 2] [--workers 2] [--root DIR]
@@ -61,6 +63,14 @@ def _med(rows, key):
     return float(np.median(v)) if v else math.nan
 
 
+def _cpu() -> float:
+    """CPU seconds [s] of this process and its waited-for children (user + system)."""
+    import resource
+
+    a, b = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return a.ru_utime + a.ru_stime + b.ru_utime + b.ru_stime
+
+
 def raise_priority() -> str:
     """Nice -10 for this process's autogroup (the scheduler's unit on Linux); what happened."""
     try:
@@ -75,9 +85,9 @@ def table(results: list) -> str:
     for r in results:
         by.setdefault(r["dataset"], {})[r["config"]] = r
     names = [c[0] for c in CONFIGS]
-    lines = ["| dataset | config | total wall [s] | fit [s] | selection [s] | report [s] | time sims (fit + selection) "
-             "| load before/after | median abs ln Gq(n0) | median abs w | median abs ln G(n_best) | class right |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| dataset | config | total wall [s] | CPU [s] | fit [s] | selection [s] | report [s] | time sims (fit + "
+             "selection) | load before/after | median abs ln Gq(n0) | median abs w | median abs ln G(n_best) | class right |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for ds, cf in by.items():
         for c in names:
             if c not in cf:
@@ -85,17 +95,20 @@ def table(results: list) -> str:
             r = cf[c]
             segs = r["segments"]
             cls = np.mean([s["class_true"] == s["class_fit"] for s in segs])
-            lines.append(f"| {ds} | {c} | {r['total_s']:.1f} | {r['fit_s']:.1f} | {r['selection_s']:.1f} | "
+            lines.append(f"| {ds} | {c} | {r['total_s']:.1f} | {r.get('cpu_s', math.nan):.1f} | {r['fit_s']:.1f} | "
+                         f"{r['selection_s']:.1f} | "
                          f"{r['report_s']:.1f} | {r['n_sims_fit']} + {r['selection_sims']} | "
                          f"{r['load'][0]:.1f} / {r['load'][1]:.1f} | {_med(segs, 'dlnGq'):.3f} | {_med(segs, 'dw'):.3f} | "
                          f"{_med(segs, 'dlnG_n_best'):.3f} | {100 * cls:.0f}% |")
     lines += ["", "| dataset | total wall ratio sim/sim : lin/lin | lin/sim : lin/lin | selection wall ratio "
-              "lin/sim : lin/lin |", "|---|---|---|---|"]
+              "lin/sim : lin/lin | CPU ratio sim/sim : lin/lin |", "|---|---|---|---|---|"]
     for ds, cf in by.items():
         if NEW in cf:
             n = cf[NEW]
             f = (lambda c, k: f"{cf[c][k] / n[k]:.2f}" if c in cf else "-")
-            lines.append(f"| {ds} | {f(REF, 'total_s')} | {f('lin/sim', 'total_s')} | {f('lin/sim', 'selection_s')} |")
+            cpu = (f"{cf[REF]['cpu_s'] / n['cpu_s']:.2f}" if REF in cf and "cpu_s" in cf[REF] and "cpu_s" in n else "-")
+            lines.append(f"| {ds} | {f(REF, 'total_s')} | {f('lin/sim', 'total_s')} | {f('lin/sim', 'selection_s')} | "
+                         f"{cpu} |")
     lines += ["", "Selection check (lin/sim: all candidates simulated; lin/lin: linear-corrected except the "
               "simulated ones); Table 2 RMS error [%] of axle_acc_3L/R:",
               "| dataset | same fit | candidates | simulated in lin/lin | max abs diff per candidate [%] | "
@@ -200,23 +213,25 @@ def main(argv=None) -> int:
                     summaries[(name, cname)] = json.loads((run / "summary.json").read_text())
                 continue
             load0 = os.getloadavg()[0]
+            cpu0 = _cpu()
             t0 = time.perf_counter()
             summ = run_inversion(blind, run, workers=a.workers, seed=0, candidates=a.candidates,
                                  max_iter=a.max_iter, force=True, fit_model=fit, selection=selection)
             wall = time.perf_counter() - t0
+            cpu = _cpu() - cpu0       # this process and its pool workers (reaped at the run's end)
             summaries[(name, cname)] = summ
             tm = summ["timing"]
             r = {"dataset": name, "config": cname, "fit": fit, "selection": selection, "total_s": tm["total_s"],
                  "fit_s": tm["fit_s"], "selection_s": tm["selection_s"], "report_s": tm["report_s"], "wall_s": wall,
                  "n_sims_fit": summ["fit"]["n_sims"], "selection_sims": tm.get("selection_sims"),
-                 "n_sims": tm["n_sims"], "load": [load0, os.getloadavg()[0]], "priority": prio,
+                 "n_sims": tm["n_sims"], "load": [load0, os.getloadavg()[0]], "priority": prio, "cpu_s": cpu,
                  "candidates": summ["selection"]["n_candidates"] - 1, **score_case(truth, summ)}
             if cname == NEW and (name, "lin/sim") in summaries:
                 r["check"] = selection_check(summaries[(name, "lin/sim")], summ)
             with res_file.open("a") as f:
                 f.write(json.dumps(r) + "\n")
             done[(name, cname)] = r
-            print(f"{name} {cname}: total {r['total_s']:.1f} s (fit {r['fit_s']:.1f}, selection {r['selection_s']:.1f}, "
+            print(f"{name} {cname}: total {r['total_s']:.1f} s, CPU {cpu:.1f} s (fit {r['fit_s']:.1f}, selection {r['selection_s']:.1f}, "
                   f"report {r['report_s']:.1f}), sims {r['n_sims_fit']} + {r['selection_sims']}, load "
                   f"{r['load'][0]:.1f}/{r['load'][1]:.1f}, dlnGq {[round(s['dlnGq'], 2) for s in r['segments']]}",
                   flush=True)
