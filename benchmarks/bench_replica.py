@@ -185,6 +185,9 @@ def main(argv=None) -> int:
     ap.add_argument("--effects", nargs="*", default=[], metavar="FAMILY:NAME=VALUE",
                     help="effects given to the replica's linear model for one family's drives "
                          "(e.g. random:frame_flex=1: what a diagnosis would name)")
+    ap.add_argument("--diagnosis", nargs="*", default=[], metavar="FAMILY:PATTERN",
+                    help="use the effects named by 'eroad diagnose' run folders, PATTERN with {seed} "
+                         "(e.g. random:/tmp/diag/diag-{seed}); the closed-loop rule of eroad replica --effects auto")
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -195,7 +198,7 @@ def main(argv=None) -> int:
 
     record = run_info("replica_benchmark", run_id=out.name, command=command, seed=None,
                       extra={"families": args.families, "holdout": args.holdout, "lines": args.lines,
-                             "effects": args.effects})
+                             "effects": args.effects, "diagnosis": args.diagnosis})
     write_run_json(out, record)
     t_start = time.perf_counter()
     cases = []
@@ -205,7 +208,19 @@ def main(argv=None) -> int:
         fam, _, n = item.partition(":")
         for seed in range(1, int(n or 1) + 1):
             eff = [e.split(":", 1)[1] for e in args.effects if e.split(":", 1)[0] == fam]
+            verdict = None
+            for d in args.diagnosis:
+                dfam, pattern = d.split(":", 1)
+                if dfam == fam:   # the effects a blind diagnosis of this drive named (the closed-loop rule)
+                    from diagnosis.closed_loop import effects_from_diagnosis
+                    dsum = json.loads((Path(pattern.format(seed=seed)) / "summary.json").read_text())
+                    named, reason = effects_from_diagnosis(dsum)
+                    eff += [f"{k}.{pn}={pv!r}" for k, pp in (named or {}).items() for pn, pv in pp.items()]
+                    verdict = {"verdict": dsum.get("verdict"), "confidence": dsum.get("verdict_confidence"),
+                               "reason": reason}
             case = run_case(fam, seed, cache, holdout=seed <= args.holdout, lines=args.lines, effects=eff)
+            if verdict is not None:
+                case["diagnosis"] = verdict
             cases.append(case)
             with jl.open("a") as f:
                 f.write(json.dumps(case) + "\n")
