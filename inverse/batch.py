@@ -4,7 +4,8 @@ What it is for: one inversion per dataset, each an ordinary run folder ``ROOT/<d
 folder name>/`` (what :func:`inverse.run.run_inversion` writes, with its archive record
 ``run.json``), the drives spread over the workers of a ``dask.distributed`` cluster:
 a new ``LocalCluster`` of ``n_workers`` processes with one thread each by default, or
-an existing cluster given by its scheduler address -- the conventions of the sweeps
+an existing cluster given by its scheduler address, or (``n_workers`` 0 or 1) one after the
+other in this process without Dask -- the conventions of the sweeps
 (``studies.sweep.dask_client``; this module sits below ``studies`` and so does not
 import it).  A drive that fails does not stop the others: its one-line error is
 reported, its folder holds a ``run.json`` with status ``failed`` (unless the folder
@@ -145,7 +146,8 @@ def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: s
         Address of an existing Dask scheduler (``tcp://host:8786``); default a new
         ``LocalCluster`` of ``n_workers`` processes.
     n_workers : int
-        Local worker processes (>= 1; ignored with ``scheduler``).
+        Local worker processes (ignored with ``scheduler``); 0 or 1: the drives one after
+        the other in this process, no Dask (the sweeps' convention).
     runner : str
         ``"module:function"`` run per drive as ``function(dataset, out, argv=..., **kwargs)``,
         returning the run's summary dict.
@@ -166,13 +168,11 @@ def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: s
         complete run ``classes``, ``fit_quality``, ``rms_err`` (Table 2's medians).
         Also written to ``root/batch.json``.
     """
-    from eroad.archive import write_json_atomic
-
     datasets = [str(d) for d in datasets]
     if not datasets:
         raise EroadInputError("eroad invert: no dataset given")
-    if not (isinstance(n_workers, int) and n_workers >= 1):
-        raise EroadInputError(f"--workers must be an integer >= 1, got {n_workers!r}")
+    if not (isinstance(n_workers, int) and n_workers >= 0):
+        raise EroadInputError(f"--workers must be an integer >= 0, got {n_workers!r}")
     root = Path(root)
     if root.exists() and not root.is_dir():
         raise EroadInputError(f"{root}: exists and is not a folder")
@@ -181,6 +181,13 @@ def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: s
     argv = list(argv) if argv is not None else ["invert_many"]
     t0 = _time.perf_counter()
     results = [None] * len(datasets)
+    if scheduler is None and n_workers <= 1:      # serial, no Dask: the same function per drive
+        root.mkdir(parents=True, exist_ok=True)
+        for i, (d, n) in enumerate(zip(datasets, names)):
+            results[i] = _invert_one(runner, d, str(root / n), kwargs, argv)
+            if report is not None:
+                report(results[i])
+        return _record(root, results, argv, "serial (no Dask)", t0)
     with _client(scheduler, n_workers, connect_timeout) as client:
         from distributed import as_completed
 
@@ -202,8 +209,14 @@ def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: s
         finally:
             if futures:
                 client.cancel(list(futures))
-    record = {"command": argv, "scheduler": scheduler or f"LocalCluster({n_workers} workers)",
-              "wall_s": round(_time.perf_counter() - t0, 3),
+    return _record(root, results, argv, scheduler or f"LocalCluster({n_workers} workers)", t0)
+
+
+def _record(root: Path, results: list, argv: list, where: str, t0: float) -> list:
+    """Write ``root/batch.json`` (every drive's outcome) and return ``results``."""
+    from eroad.archive import write_json_atomic
+
+    record = {"command": argv, "scheduler": where, "wall_s": round(_time.perf_counter() - t0, 3),
               "n_complete": sum(r["status"] == "complete" for r in results),
               "n_failed": sum(r["status"] == "failed" for r in results),
               "runs": [{**r, "run": Path(r["run"]).name} for r in results]}

@@ -39,7 +39,8 @@ def register(subparsers) -> None:
                         "datasets: a local cluster of --workers processes, each drive serial in one")
     p.add_argument("--segments", type=int, default=None, help="number of segments K (default: BIC criterion)")
     p.add_argument("--workers", type=int, default=2,
-                   help="processes for the simulations (default 2); several datasets: local Dask workers")
+                   help="processes for the simulations (default 2); several datasets: local Dask workers "
+                        "(0 or 1: one drive after the other, no Dask)")
     p.add_argument("--seed", type=int, default=0, help="root seed of the fit and candidate phases")
     p.add_argument("--candidates", type=int, default=None,
                    help="phase realisations tried in the selection (default 16, 6 with --quick; 0: keep the fit's)")

@@ -70,6 +70,10 @@ def test_batch_bad_input_is_one_line(drives, tmp_path, capsys):
         run_folder_names(["a/d", "b/d"])
     with pytest.raises(EroadInputError, match="no dataset"):
         invert_many([], tmp_path / "R4")
+    # --workers 0 or 1: serial, no Dask (the sweeps' convention); the broken drive is reported
+    res = invert_many([drives / "bad"], tmp_path / "R5", n_workers=1)
+    assert res[0]["status"] == "failed" and "meta.toml" in res[0]["error"]
+    assert json.loads((tmp_path / "R5" / "batch.json").read_text())["scheduler"] == "serial (no Dask)"
 
 
 def test_one_line():
