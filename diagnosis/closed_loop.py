@@ -133,8 +133,7 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     try:
         if diagnosis is not None:
             dsum = json.loads((Path(diagnosis) / "summary.json").read_text())
-            if copy_diagnosis:
-                shutil.copytree(diagnosis, work / "diagnose")
+            shutil.copytree(diagnosis, work / "diagnose")
         else:
             progress("closed loop: diagnosing the nominal model's gap ...")
             dsum = diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed)
