@@ -75,12 +75,13 @@ def test_bounds_respected_and_history_saved(recovery):
 
 
 def test_bound_is_active_when_truth_lies_outside():
-    """A road with w = 3.4 (above the upper bound 3.0): the fit stops on the bound."""
-    P = np.array([[256e-6, 3.4, 0.05, 5.0]])
+    """A road with w = 4.0 (above the upper bound 3.5, inverse.spectral.ParamBounds): the fit
+    stops on the bound."""
+    P = np.array([[256e-6, 4.0, 0.05, 5.0]])
     d, fset, sim = _setup(P, [20.0], seed=3)
     bounds = ParamBounds().for_record(d.fs, d.speed.max())
     res = fit_segments(sim, fset, [[256e-6, 2.0, 0.1, 2.5]], seed=11, bounds=bounds)
-    assert res.params[0, 1] == pytest.approx(3.0, abs=1e-6)
+    assert res.params[0, 1] == pytest.approx(bounds.w[1], abs=1e-6) and bounds.w[1] == 3.5
     assert np.all(res.theta >= bounds.theta_lower() - 1e-9) and np.all(res.theta <= bounds.theta_upper() + 1e-9)
 
 
