@@ -263,12 +263,13 @@ def table(cases: list) -> str:
         lines.append(f"| {name} | {len(rs)} | {np.median(g):.3f} | {g.max():.3f} | "
                      f"{100 * np.mean(g <= math.log(1.2)):.0f}% | {np.median(w):.3f} | {w.max():.3f} | "
                      f"{100 * np.mean(w <= 0.15):.0f}% | {100 * cl:.0f}% | {b} |")
-        orc = [r["oracle"] for r in rs if r.get("oracle")]
+        pairs = [(r, r["oracle"]) for r in rs if r.get("oracle")]   # rows without an oracle are skipped
+        orc = [o for _, o in pairs]
         if orc:
             from roadlib.psd import class_of
             go = np.array([o["dlnGq"] for o in orc])
             wo = np.array([o["dw"] for o in orc])
-            clo = np.mean([class_of(o["Gq"]) == r["class_true"] for r, o in zip(rs, orc)])
+            clo = np.mean([class_of(o["Gq"]) == r["class_true"] for r, o in pairs])
             lines.append(f"| {name}, true-road oracle | {len(orc)} | {np.median(go):.3f} | {go.max():.3f} | "
                          f"{100 * np.mean(go <= math.log(1.2)):.0f}% | {np.median(wo):.3f} | {wo.max():.3f} | "
                          f"{100 * np.mean(wo <= 0.15):.0f}% | {100 * clo:.0f}% | |")

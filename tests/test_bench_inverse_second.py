@@ -97,3 +97,17 @@ def test_fitted_psd_one_and_two_slopes():
     f2 = dict(f, w2=3.5, n_break=0.5)
     assert B.fitted_psd(f2, 1.0) == pytest.approx(2.0e-4 * 5.0 ** -2.5 * 2.0 ** -3.5, rel=1e-12)
     assert B.fitted_psd(f2, 0.3) == pytest.approx(B.fitted_psd(f, 0.3), rel=1e-12)
+
+
+def test_table_pairs_each_oracle_with_its_own_segment():
+    """A measured-road row has no oracle: the oracle's class must still be compared with the
+    class of the segment it belongs to (a zip over the filtered list shifted them)."""
+    def row(gq, oracle):
+        from roadlib.psd import class_of
+        return {"duration_s": 10.0, "dlnGq": 0.0, "dw": 0.0, "class_true": class_of(gq), "class_fit": class_of(gq),
+                "dlnG_1cpm": 0.0, "oracle": oracle}
+    measured = row(1e-4, None)                                   # class B, no oracle
+    synthetic = row(1.6e-2, {"Gq": 1.6e-2, "dlnGq": 0.0, "dw": 0.0})   # class E, oracle right
+    cases = [{"segments": [measured, synthetic], "boundary_err_s": [], "K_true": 2, "K_fit": 2, "wall_s": 1.0}]
+    line = next(x for x in B.table(cases).splitlines() if x.startswith("| all, true-road oracle"))
+    assert line.split("|")[9].strip() == "100%"
