@@ -152,7 +152,7 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
             if fq.get("status") == "poor":   # the named effect did not make the model explain it
                 fq["message"] = still_poor_message(fq, effects)
                 from inverse.report import table1, table1_note
-                write_table(table1(chosen["segments"]), main / "tables" / "table1", note=table1_note(fq))
+                write_table(table1(chosen["segments"]), main / "tables" / "table1", note=table1_note(fq, segments=chosen["segments"]))
         else:
             chosen, main = nominal, work / "nominal"
         (work / "diagnose").rename(main / "diagnose")

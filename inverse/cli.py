@@ -118,6 +118,10 @@ def _cmd_invert(args) -> int:
         fq = summary.get("fit_quality", {})
         if fq.get("status") == "poor":
             print(f"POOR FIT: {fq['message']}")
+        for i, sg in enumerate(segs):
+            if sg.get("at_bound"):
+                print(f"ON A BOUND: segment {i + 1}: {', '.join(sg['at_bound'])} (the road lies outside the "
+                      f"road model's range; docs/road_model.md)")
         if "closed_loop" in summary:
             print(f"closed loop: {summary['closed_loop']['reason']}")
     return 0

@@ -96,6 +96,29 @@ class InversionConfig:
     linear_corrections: int = 2
 
 
+#: a fitted parameter this close to a bound is reported as on it (w [-]; ln Gq_n0 [-])
+AT_BOUND_TOL = {"w": 0.01, "ln_Gq_n0": 0.01}
+
+
+def at_bounds(Gq_n0: float, w: float, bounds) -> list:
+    """Which of a segment's fitted level and waviness sit on a bound of the fit, as
+    strings such as ``"w = 3.5 (upper bound)"``: the data pushed the parameter out of
+    the range the road model allows, so its value (and the level traded against it) is
+    the bound's, not the road's."""
+    out = []
+    lw, hw = bounds.w
+    if w >= hw - AT_BOUND_TOL["w"]:
+        out.append(f"w = {hw:g} (upper bound)")
+    elif w <= lw + AT_BOUND_TOL["w"]:
+        out.append(f"w = {lw:g} (lower bound)")
+    lg = math.log(Gq_n0)
+    if lg >= math.log(bounds.Gq_n0[1]) - AT_BOUND_TOL["ln_Gq_n0"]:
+        out.append(f"Gq_n0 = {bounds.Gq_n0[1]:g} m^3 (upper bound)")
+    elif lg <= math.log(bounds.Gq_n0[0]) + AT_BOUND_TOL["ln_Gq_n0"]:
+        out.append(f"Gq_n0 = {bounds.Gq_n0[0]:g} m^3 (lower bound)")
+    return out
+
+
 @dataclass
 class Inversion:
     """Result of :func:`invert`."""
@@ -126,7 +149,8 @@ class Inversion:
             (noise, realisation and model-form error, calibrated on blind drives);
             ``sd_laplace`` and ``sd_ln_G_n_best_laplace`` the fit's noise-only ones;
             ``interval90`` the 90 % intervals of Gq_n0, w and G_n_best; ``fit_quality``
-            the gate (status 'clean' or 'poor', misfit per feature).
+            the gate (status 'clean' or 'poor', misfit per feature); ``at_bound`` the
+            fitted level or waviness sitting on a bound of the fit (:func:`at_bounds`).
         """
         from inverse.uncertainty import fit_quality, honest_sd, interval90
 
@@ -152,6 +176,7 @@ class Inversion:
                          "sd_laplace": d["sd"], "sd_ln_Gq_n0": sd["ln_Gq_n0"], "interval90": iv,
                          "fit_quality": fit_quality(d["objective"], d["n_features"]),
                          "objective": d["objective"], "n_features": d["n_features"], "converged": d["converged"],
+                         "at_bound": at_bounds(d["Gq_n0"], d["w"], self.config.bounds),
                          **best})
         return rows
 

@@ -76,7 +76,7 @@ ROAD_MODEL_NOTE = (
     "one-slope fit.")
 
 
-def table1_note(fit_quality: dict | None = None, road_model: bool = True) -> str:
+def table1_note(fit_quality: dict | None = None, road_model: bool = True, segments=None) -> str:
     """The paragraph under Table 1: what the uncertainty columns mean, and the gate's verdict;
     with ``road_model`` (default: every run reports it) also what the road-model columns
     mean (:data:`ROAD_MODEL_NOTE`)."""
@@ -90,6 +90,12 @@ def table1_note(fit_quality: dict | None = None, road_model: bool = True) -> str
         note = f"**POOR FIT**: {fit_quality['message']}.\n\n" + note
     if road_model:
         note += " " + ROAD_MODEL_NOTE
+    pinned = [f"segment {i + 1}: {', '.join(r['at_bound'])}" for i, r in enumerate(segments or [])
+              if r.get("at_bound")]
+    if pinned:
+        note += (" **On a bound**: " + "; ".join(pinned) + ". The data pushed these parameters to the edge "
+                 "of the road model's range (docs/road_model.md): the road is outside it, and the value "
+                 "is the bound's, not the road's.")
     return note
 
 

@@ -311,7 +311,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             }
             summary["lateral"] = lateral
             write_table(table1(segs), tmp / "tables" / "table1",
-                        note=table1_note(summary["fit_quality"]) + "\n\n" + note_line(summary["lateral"]))
+                        note=table1_note(summary["fit_quality"], segments=summary["segments"]) + "\n\n" + note_line(summary["lateral"]))
             basis = ""
             if sel["method"] == "linear":
                 basis = (f" Realisations: {sel['n_simulated']} of {len(seeds)} simulated in time, the others the "

@@ -43,3 +43,21 @@ def test_grid_spacing():
     assert grid_spacing(5.0) == 0.05
     assert grid_spacing(8.87) == 0.025
     assert grid_spacing(2.0) == 0.125
+
+
+def test_parameters_on_a_bound_are_named_and_reach_table1_note():
+    # a fit that ends on the w bound (the measured-road case of issue 14) is reported as such
+    # in the segment row's at_bound and in the note under Table 1; inside the range: nothing
+    from inverse.pipeline import at_bounds
+    from inverse.report import table1_note
+    from inverse.spectral import ParamBounds
+
+    b = ParamBounds()
+    assert at_bounds(100e-6, 2.0, b) == []
+    hw = b.w[1]
+    pinned = at_bounds(100e-6, hw - 0.001, b)
+    assert pinned == [f"w = {hw:g} (upper bound)"]
+    assert at_bounds(b.Gq_n0[0], 2.0, b) == [f"Gq_n0 = {b.Gq_n0[0]:g} m^3 (lower bound)"]
+    note = table1_note({"status": "clean"}, segments=[{"at_bound": []}, {"at_bound": pinned}])
+    assert "On a bound" in note and "segment 2" in note and "segment 1" not in note
+    assert "On a bound" not in table1_note({"status": "clean"}, segments=[{"at_bound": []}])
