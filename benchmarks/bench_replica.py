@@ -19,7 +19,7 @@ then:
 Usage::
 
     nice python benchmarks/bench_replica.py --families null:10 second:5 random:3 \
-        --holdout 3 --out results/replica
+        --holdout 3 --out results/replica/<date>-<what>
 
 Writes ``cases.jsonl`` (one line per drive, appended as they finish), ``summary.json``
 and ``summary.md`` in --out.
@@ -204,7 +204,7 @@ def main(argv=None) -> int:
                     help="FAMILY:N (seeds 1..N)")
     ap.add_argument("--holdout", type=int, default=3, help="drives per family with the axle-2 hold-out")
     ap.add_argument("--cache", default="/tmp/eroad-replica-bench", help="where the synthetic drives go")
-    ap.add_argument("--out", default=str(ROOT / "results" / "replica"))
+    ap.add_argument("--out", required=True, help="run folder, e.g. results/replica/<date>-<what>")
     ap.add_argument("--lines", choices=("tyre", "track"), default="tyre", help="replica unknowns per side")
     ap.add_argument("--effects", nargs="*", default=[], metavar="FAMILY:NAME=VALUE",
                     help="effects given to the replica's linear model for one family's drives "
