@@ -457,7 +457,13 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
     lo_v, hi_v = float(np.nanmin(vals)), float(np.nanmax(vals))
     rng = max(hi_v - lo_v, 0.5)
     tw.set_ylim(lo_v - 1.5 * rng, hi_v + 0.3 * rng)  # squares above the loss markers
-    tw.set_ylabel("lowest unfiltered force [N] (squares; dotted: base still)", fontsize=8)
+    tw.set_ylabel("lowest unfiltered force [N] (squares; dotted: base still)", fontsize=8, color="0.3")
+    tw.tick_params(axis="y", colors="0.3")
+    from matplotlib.lines import Line2D
+    ax[0, 1].legend(handles=[Line2D([], [], marker="o", color="0.4", ls="-", label="contact loss [%] (left axis)"),
+                             Line2D([], [], marker="s", color="0.4", ls="--", ms=4,
+                                    label="lowest unfiltered force [N] (right axis)")],
+                    fontsize=7, loc="upper center", bbox_to_anchor=(0.5, 0.86), ncol=2)
     ax[1, 0].set_ylabel("sd of F(drive) - F(base still) [N] (20 Hz)")
     ax[1, 0].set_title("(c) part of the force the base excitation causes", fontsize=10)
     for a in (ax[0, 0], ax[0, 1], ax[1, 0]):
