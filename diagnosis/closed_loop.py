@@ -69,6 +69,22 @@ def effects_from_diagnosis(summary: dict) -> tuple[dict | None, str]:
     return params, f"the diagnosis named {verdict} ({how}); inverted with {text}"
 
 
+def _diagnosis_summary(dataset, work: Path, diagnosis, copy: bool, workers: int, quick: bool, seed: int,
+                       progress) -> dict:
+    """The diagnosis of a closed loop: a given run folder's summary (copied to work/diagnose
+    when ``copy``), or a fresh diagnosis written there."""
+    if diagnosis is not None:
+        if not (Path(diagnosis) / "summary.json").is_file():
+            raise EroadInputError(f"{diagnosis}: not a diagnosis run folder (no summary.json)")
+        if copy:
+            shutil.copytree(diagnosis, work / "diagnose")
+        return json.loads((Path(diagnosis) / "summary.json").read_text())
+    from diagnosis.pipeline import diagnose
+
+    progress("closed loop: diagnosing the nominal model's gap ...")
+    return diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed)
+
+
 def still_poor_message(fit_quality: dict, effects: dict) -> str:
     """The gate's one line for a corrected fit that is still poor: the advice to run the
     diagnosis has been followed, so say what is left instead."""
@@ -117,7 +133,6 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     dict
         The chosen inversion's summary with ``closed_loop`` added.
     """
-    from diagnosis.pipeline import diagnose
     from drives.format import swap_into_place, temp_folder_beside
     from eroad.archive import write_json_atomic
     from inverse.report import write_table
@@ -131,12 +146,7 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     out.parent.mkdir(parents=True, exist_ok=True)
     work = temp_folder_beside(out)
     try:
-        if diagnosis is not None:
-            dsum = json.loads((Path(diagnosis) / "summary.json").read_text())
-            shutil.copytree(diagnosis, work / "diagnose")
-        else:
-            progress("closed loop: diagnosing the nominal model's gap ...")
-            dsum = diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed)
+        dsum = _diagnosis_summary(dataset, work, diagnosis, True, workers, quick, seed, progress)
         effects, reason = effects_from_diagnosis(dsum)
         progress(f"closed loop: {reason}")
         progress("closed loop: nominal inversion ...")
@@ -188,7 +198,6 @@ def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick:
     ``RUN/diagnose/`` and ``summary.json`` ``closed_loop``.  ``diagnosis``: an existing
     diagnosis run folder of this dataset to use instead of diagnosing again.
     """
-    from diagnosis.pipeline import diagnose
     from drives.format import swap_into_place, temp_folder_beside
     from eroad.archive import write_json_atomic
     from inverse.replica import run_replica
@@ -201,15 +210,7 @@ def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick:
     out.parent.mkdir(parents=True, exist_ok=True)
     work = temp_folder_beside(out)
     try:
-        if diagnosis is not None:
-            if not (Path(diagnosis) / "summary.json").is_file():
-                raise EroadInputError(f"{diagnosis}: not a diagnosis run folder (no summary.json)")
-            dsum = json.loads((Path(diagnosis) / "summary.json").read_text())
-            if copy_diagnosis:
-                shutil.copytree(diagnosis, work / "diagnose")
-        else:
-            progress("closed loop: diagnosing the nominal model's gap ...")
-            dsum = diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed)
+        dsum = _diagnosis_summary(dataset, work, diagnosis, copy_diagnosis, workers, quick, seed, progress)
         effects, reason = effects_from_diagnosis(dsum)
         reason = reason.replace("; inverted with", "; reconstructed with")
         progress(f"closed loop: {reason}")

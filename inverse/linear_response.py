@@ -146,17 +146,7 @@ class LinearRealisation:
     # ------------------------------------------------------------------ model
     def _discretise(self, lm) -> None:
         A, B = lm.state_space()
-        n = lm.n_dof
-        nch = len(self.channels)
-        C = np.zeros((nch, 2 * n))
-        D = np.zeros((nch, B.shape[1]))
-        for k, name in enumerate(self.channels):
-            o = lm.output(name)
-            if o.order == 0:
-                C[k, :n] = o.row
-            else:
-                C[k] = o.row @ A[n:, :]
-                D[k] = o.row @ B[n:, :]
+        C, D = lm.output_matrices(self.channels, A, B)
         # steady state of a constant input u0 = [z0, 0]: x = -A^-1 B u0 (K is regular: tyres hold
         # every coordinate), outputs C x + D u0
         self.G_static = (-C @ np.linalg.solve(A, B) + D)[:, : B.shape[1] // 2]

@@ -168,16 +168,7 @@ class ReplicaOperator:
         self.nf, self.nc = nf, nc
         # continuous state space x = [q, q'], u = [z_r, z_r'] -> outputs
         A, B = lm.state_space()
-        n = lm.n_dof
-        C = np.zeros((len(self.channels), 2 * n))
-        Dm = np.zeros((len(self.channels), B.shape[1]))
-        for k, name in enumerate(self.channels):
-            o = lm.output(name)
-            if o.order == 0:
-                C[k, :n] = o.row
-            else:
-                C[k] = o.row @ A[n:, :]
-                Dm[k] = o.row @ B[n:, :]
+        C, Dm = lm.output_matrices(self.channels, A, B)
         Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, Dm), h, method="foh")
         lam, V = np.linalg.eig(Ad)
         Vi = np.linalg.inv(V)

@@ -186,6 +186,30 @@ class LinearModel:
         B = np.vstack([np.zeros((n, 2 * self.Bk.shape[1])), Minv @ np.hstack([self.Bk, self.Bc])])
         return A, B
 
+    def output_matrices(self, channels, A=None, B=None) -> tuple:
+        """Output equation ``y = C x + D u`` of :meth:`state_space` for ``channels``.
+
+        Displacements read the coordinates; accelerations are the second derivative,
+        i.e. the acceleration rows of A and B (so they feel the road input directly).
+
+        Returns
+        -------
+        (C, D) : ndarrays (n_channels, 2n), (n_channels, 2 n_contacts)
+        """
+        if A is None or B is None:
+            A, B = self.state_space()
+        n = self.n_dof
+        C = np.zeros((len(channels), 2 * n))
+        D = np.zeros((len(channels), B.shape[1]))
+        for k, name in enumerate(channels):
+            o = self.output(name)
+            if o.order == 0:
+                C[k, :n] = o.row
+            else:
+                C[k] = o.row @ A[n:, :]
+                D[k] = o.row @ B[n:, :]
+        return C, D
+
     # ------------------------------------------------------------------ FRFs
     def coordinate_frf(self, freqs) -> np.ndarray:
         """Coordinate response to a unit road height under each contact.
