@@ -5,9 +5,8 @@ folder name>/`` (what :func:`inverse.run.run_inversion` writes, with its archive
 ``run.json``), the drives spread over the workers of a ``dask.distributed`` cluster:
 a new ``LocalCluster`` of ``n_workers`` processes with one thread each by default, or
 an existing cluster given by its scheduler address, or (``n_workers`` 0 or 1) one after the
-other in this process without Dask -- the conventions of the sweeps
-(``studies.sweep.dask_client``; this module sits below ``studies`` and so does not
-import it).  A drive that fails does not stop the others: its one-line error is
+other in this process without Dask -- the client of the sweeps
+(:func:`eroad.dask_client.dask_client`, shared with ``studies.sweep``).  A drive that fails does not stop the others: its one-line error is
 reported, its folder holds a ``run.json`` with status ``failed`` (unless the folder
 already held something), and ``ROOT/batch.json`` lists every drive's outcome.
 
@@ -22,13 +21,12 @@ importing it.  Workers of an existing cluster must have eroad installed.
 """
 from __future__ import annotations
 
-import contextlib
 import importlib
-import logging
 import os
 import time as _time
 from pathlib import Path
 
+from eroad.dask_client import dask_client
 from eroad.errors import EroadInputError
 
 __all__ = ["invert_many", "run_folder_names", "DEFAULT_RUNNER", "BATCH_FILE"]
@@ -97,41 +95,6 @@ def _invert_one(runner: str, dataset: str, out: str, kwargs: dict, argv: list) -
             "rms_err": {c: e[c].get("rms_err") for c in ("axle_acc_3L", "axle_acc_3R") if c in e}}
 
 
-@contextlib.contextmanager
-def _client(scheduler, n_workers: int, connect_timeout: float = 20.0):
-    """A quiet ``distributed.Client`` (the sweeps' settings), closed with its cluster on exit."""
-    import dask
-    from distributed import Client, LocalCluster
-
-    logger = logging.getLogger("distributed")
-    old = logger.level
-    logger.setLevel(logging.ERROR)
-    env_old = os.environ.get("DASK_LOGGING__DISTRIBUTED")
-    os.environ["DASK_LOGGING__DISTRIBUTED"] = "error"     # read by the worker processes at import
-    try:
-        with contextlib.ExitStack() as stack:
-            stack.enter_context(dask.config.set({"logging.distributed": "error"}))
-            if scheduler is None:
-                cluster = stack.enter_context(LocalCluster(
-                    n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                    scheduler_kwargs={"dashboard": False}, silence_logs=logging.ERROR))
-                client = stack.enter_context(Client(cluster, set_as_default=False))
-            else:
-                try:
-                    client = Client(scheduler, timeout=connect_timeout, set_as_default=False)
-                except (OSError, TimeoutError, ValueError) as exc:
-                    raise EroadInputError(f"--scheduler {scheduler}: cannot connect "
-                                          f"({type(exc).__name__}: {exc})") from None
-                stack.enter_context(client)
-            yield client
-    finally:
-        logger.setLevel(old)
-        if env_old is None:
-            os.environ.pop("DASK_LOGGING__DISTRIBUTED", None)
-        else:
-            os.environ["DASK_LOGGING__DISTRIBUTED"] = env_old
-
-
 def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: str = DEFAULT_RUNNER,
                 argv=None, report=None, connect_timeout: float = 20.0, **kwargs) -> list:
     """Invert every dataset into ``root/<name>`` on a Dask cluster; one result per drive.
@@ -188,7 +151,7 @@ def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: s
             if report is not None:
                 report(results[i])
         return _record(root, results, argv, "serial (no Dask)", t0)
-    with _client(scheduler, n_workers, connect_timeout) as client:
+    with dask_client(scheduler, n_workers=n_workers, connect_timeout=connect_timeout) as client:
         from distributed import as_completed
 
         root.mkdir(parents=True, exist_ok=True)
