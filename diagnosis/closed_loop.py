@@ -33,13 +33,16 @@ import pandas as pd
 from eroad.errors import EroadInputError
 
 
-def effects_from_diagnosis(summary: dict) -> tuple[dict | None, str]:
+def effects_from_diagnosis(summary: dict, action: str = "inverted") -> tuple[dict | None, str]:
     """The effects to invert with, from a diagnosis summary, and why.
 
     Parameters
     ----------
     summary : dict
         ``diagnose``'s summary.json.
+    action : str
+        What the caller does with the effects, for the reason line ("inverted",
+        "reconstructed").
 
     Returns
     -------
@@ -66,7 +69,19 @@ def effects_from_diagnosis(summary: dict) -> tuple[dict | None, str]:
     params = {str(k): {str(p): float(v) for p, v in d.items()} for k, d in entry["parameters"].items()}
     text = ", ".join(f"{k}." + ", ".join(f"{p}={v:.4g}" for p, v in d.items()) for k, d in params.items())
     how = "confidence clear" if conf == "clear" else "identified; a difference beyond it remains"
-    return params, f"the diagnosis named {verdict} ({how}); inverted with {text}"
+    return params, f"the diagnosis named {verdict} ({how}); {action} with {text}"
+
+
+def _start(out, force: bool) -> tuple[Path, Path]:
+    """A closed loop's output folder (refused if non-empty unless ``force``) and the
+    temporary work folder beside it that is renamed into place at the end."""
+    from drives.format import temp_folder_beside
+    from inverse.run import check_out
+
+    out = Path(out)
+    check_out(out, force)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return out, temp_folder_beside(out)
 
 
 def _diagnosis_summary(dataset, work: Path, diagnosis, copy: bool, workers: int, quick: bool, seed: int,
@@ -133,18 +148,14 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     dict
         The chosen inversion's summary with ``closed_loop`` added.
     """
-    from drives.format import swap_into_place, temp_folder_beside
+    from drives.format import swap_into_place
     from eroad.archive import write_json_atomic
     from inverse.report import write_table
-    from inverse.run import check_out as _check_out
     from inverse.run import dataset_path, relocate, run_inversion
 
     if "effects" in inversion:
         raise EroadInputError("--effects auto and explicit --effect values cannot be combined")
-    out = Path(out)
-    _check_out(out, force)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    work = temp_folder_beside(out)
+    out, work = _start(out, force)
     try:
         dsum = _diagnosis_summary(dataset, work, diagnosis, True, workers, quick, seed, progress)
         effects, reason = effects_from_diagnosis(dsum)
@@ -198,21 +209,16 @@ def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick:
     ``RUN/diagnose/`` and ``summary.json`` ``closed_loop``.  ``diagnosis``: an existing
     diagnosis run folder of this dataset to use instead of diagnosing again.
     """
-    from drives.format import swap_into_place, temp_folder_beside
+    from drives.format import swap_into_place
     from eroad.archive import write_json_atomic
     from inverse.replica import run_replica
-    from inverse.run import check_out as _check_out
 
     if "effects" in replica:
         raise EroadInputError("--effects auto and explicit effect values cannot be combined")
-    out = Path(out)
-    _check_out(out, force)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    work = temp_folder_beside(out)
+    out, work = _start(out, force)
     try:
         dsum = _diagnosis_summary(dataset, work, diagnosis, copy_diagnosis, workers, quick, seed, progress)
-        effects, reason = effects_from_diagnosis(dsum)
-        reason = reason.replace("; inverted with", "; reconstructed with")
+        effects, reason = effects_from_diagnosis(dsum, action="reconstructed")
         progress(f"closed loop: {reason}")
         summary = run_replica(dataset, work / "replica", effects=effects, argv=argv, progress=progress, **replica)
         main = work / "replica"

@@ -166,6 +166,16 @@ def log_bias(dof) -> np.ndarray:
     return digamma(h) - np.log(h)
 
 
+def split_linear_effects(effects) -> tuple[dict, dict]:
+    """Resolved effects split into the linear ones (kept by a linear model as they are)
+    and the nonlinear ones (``Effect.nonlinear``), both in application order."""
+    from vehicles.effects import EFFECTS, resolve_effects
+
+    eff = resolve_effects(effects) if effects else {}
+    linear = {k: v for k, v in eff.items() if not EFFECTS[k].nonlinear}
+    return linear, {k: v for k, v in eff.items() if k not in linear}
+
+
 def linear_model_for(vehicle, chassis: str = "rigid", effects=None):
     """The linear model of the fit: the vehicle with its LINEAR effects only.
 
@@ -177,14 +187,11 @@ def linear_model_for(vehicle, chassis: str = "rigid", effects=None):
     -------
     (LinearModel, list of str) : the model and the effects left out.
     """
-    from vehicles.effects import EFFECTS, resolve_effects
     from vehicles.linear import linear_model
     from vehicles.params import load_vehicle
 
-    eff = resolve_effects(effects) if effects else {}
-    keep = {k: v for k, v in eff.items() if not EFFECTS[k].nonlinear}
-    left = sorted(set(eff) - set(keep))
-    return linear_model(load_vehicle(vehicle), chassis, effects=keep or None), left
+    keep, nonlinear = split_linear_effects(effects)
+    return linear_model(load_vehicle(vehicle), chassis, effects=keep or None), sorted(nonlinear)
 
 
 class LinearFeatures:

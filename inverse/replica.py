@@ -698,15 +698,14 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float) -> tuple:
     """
     from scipy.signal import butter, sosfiltfilt
 
-    from vehicles.effects import EFFECTS, resolve_effects
+    from inverse.linear_features import split_linear_effects
     from vehicles.linear import linear_model
     from vehicles.params import load_vehicle
 
     vp = load_vehicle(vehicle)
-    eff = resolve_effects(effects) if effects else {}
-    keep = {k: dict(v) for k, v in eff.items() if not EFFECTS[k].nonlinear}
+    keep, nonlinear = split_linear_effects(effects)
     notes = []
-    if "leaf_friction" in eff and eff["leaf_friction"]["force"] > 0:
+    if "leaf_friction" in nonlinear and nonlinear["leaf_friction"]["force"] > 0:
         leaf_axles = {i + 1 for i, a in enumerate(vp.axles) if getattr(a, "spring_type", "") == "leaf"}
         disp = [np.asarray(y, float) for c, y in channels.items()
                 if c.startswith("susp_disp_") and axle_of(c) in leaf_axles]
@@ -714,14 +713,13 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float) -> tuple:
             sos = butter(4, min(VELOCITY_LOWPASS_HZ, 0.4 * fs), fs=fs, output="sos")
             vel = [np.gradient(sosfiltfilt(sos, d - d.mean())) * fs for d in disp]
             s = float(np.sqrt(np.mean([np.mean(v ** 2) for v in vel])))
-            p = dict(eff["leaf_friction"])
+            p = dict(nonlinear["leaf_friction"])
             c_eq = p["force"] / max(p["velocity"], s * math.sqrt(math.pi / 2.0))
             keep["leaf_friction"] = {"force": c_eq * p["velocity"], "velocity": p["velocity"]}   # F'/v0 = c_eq
             notes.append(f"leaf_friction {p['force']:.0f} N statistically linearised: suspension velocity "
                          f"RMS {s * 1e3:.0f} mm/s -> damping {c_eq:.0f} N s/m per spring")
-    left = sorted(set(eff) - set(keep))
-    ordered = {k: keep[k] for k in eff if k in keep}
-    return linear_model(vp, "rigid", effects=ordered or None), left, notes
+    left = sorted(set(nonlinear) - set(keep))
+    return linear_model(vp, "rigid", effects=keep or None), left, notes   # applied in the effects' own order
 
 
 # --------------------------------------------------------------------------- scoring helpers

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from eroad.argtypes import positive_float
 from eroad.errors import EroadInputError
 
 SEGMENT_KEYS = {"class", "Gq_n0", "length", "w", "nmin", "nmax", "lambda"}
@@ -364,14 +365,6 @@ def cmd_plot(args) -> int:
 
 
 # ----------------------------------------------------------------------------- parser
-def _positive(text):
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not (math.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f"{text!r} must be positive")
-    return v
 
 
 def _nonneg(text):
@@ -401,20 +394,20 @@ def register(subparsers) -> None:
                        "explicit level, or segments. Writes FILE and FILE.summary.json beside it.")
     src = g.add_argument_group("road spectrum (one of)")
     src.add_argument("--class", dest="iso_class", metavar="CLASS", help="ISO 8608 class A-H (geometric mean level)")
-    src.add_argument("--gd0", type=_positive, metavar="GQ_N0", help="Gd(n0) at n0 = 0.1 cycles/m [m^3], e.g. 256e-6")
+    src.add_argument("--gd0", type=positive_float, metavar="GQ_N0", help="Gd(n0) at n0 = 0.1 cycles/m [m^3], e.g. 256e-6")
     src.add_argument("--segment", action="append", metavar="CLASS:LENGTH",
                      help="a segment of class CLASS and LENGTH [m]; repeat in travel order")
     src.add_argument("--segments", metavar="FILE.toml",
                      help="[[segment]] tables: class or Gq_n0 [m^3], length [m], optional w, nmin, nmax, lambda")
-    g.add_argument("--w", type=_positive, default=2.0, help="waviness [-] (default 2)")
-    g.add_argument("--nmin", type=_positive, default=0.011, help="lowest spatial frequency [cycles/m] (0.011)")
-    g.add_argument("--nmax", type=_positive, default=2.83, help="highest spatial frequency [cycles/m] (2.83)")
-    g.add_argument("--length", type=_positive, default=None, help="road length [m] (default 1000; "
+    g.add_argument("--w", type=positive_float, default=2.0, help="waviness [-] (default 2)")
+    g.add_argument("--nmin", type=positive_float, default=0.011, help="lowest spatial frequency [cycles/m] (0.011)")
+    g.add_argument("--nmax", type=positive_float, default=2.83, help="highest spatial frequency [cycles/m] (2.83)")
+    g.add_argument("--length", type=positive_float, default=None, help="road length [m] (default 1000; "
                    "with segments the sum of their lengths)")
     g.add_argument("--width", type=_nonneg, default=4.0, help="road width [m], centred on y = 0 (default 4; 0 = one track)")
-    g.add_argument("--dx", type=_positive, default=0.1, help="grid step along the road [m] (0.1)")
-    g.add_argument("--dy", type=_positive, default=0.1, help="grid step across the road [m] (0.1)")
-    g.add_argument("--lambda", dest="lam", type=_positive, default=1.0,
+    g.add_argument("--dx", type=positive_float, default=0.1, help="grid step along the road [m] (0.1)")
+    g.add_argument("--dy", type=positive_float, default=0.1, help="grid step across the road [m] (0.1)")
+    g.add_argument("--lambda", dest="lam", type=positive_float, default=1.0,
                    help="anisotropy factor [-] of the surface PSD (1 isotropic, > 1 more coherent across)")
     g.add_argument("--seed", type=int, default=0, help="root seed (default 0)")
     g.add_argument("--out", required=True, metavar="FILE", help="output road file, .npz or .crg")
@@ -427,9 +420,9 @@ def register(subparsers) -> None:
                        "in linear space (Whittle likelihood); report the ISO class.")
     p.add_argument("file", help="road file (.npz/.crg; all tracks averaged unless --track) or x z profile text")
     p.add_argument("--track", type=float, default=None, help="use only the track at lateral position Y [m]")
-    p.add_argument("--band", type=_positive, nargs=2, metavar=("LOW", "HIGH"),
+    p.add_argument("--band", type=positive_float, nargs=2, metavar=("LOW", "HIGH"),
                    help="fit band [cycles/m] (default: ISO band within the data)")
-    p.add_argument("--segment-length", type=_positive, default=None, help="Welch segment length [m]")
+    p.add_argument("--segment-length", type=positive_float, default=None, help="Welch segment length [m]")
     p.add_argument("--fixed-w", action="store_true", help="fix w = 2 (the ISO class definition)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=cmd_psd)
@@ -437,7 +430,7 @@ def register(subparsers) -> None:
     i = sub.add_parser("iri", help="IRI per segment (golden quarter car, ASTM E1926)",
                        description="International Roughness Index per segment [m/km].")
     i.add_argument("profile", help="two-column x [m] z [m] text (space or comma separated), or .npz/.crg with --track")
-    i.add_argument("--segment", type=_positive, required=True, metavar="LENGTH", help="segment length [m]")
+    i.add_argument("--segment", type=positive_float, required=True, metavar="LENGTH", help="segment length [m]")
     i.add_argument("--track", type=float, default=None, help="lateral position Y [m] of the track in a road file")
     i.add_argument("--start", type=float, default=None, help="start of the first segment [m] (default first sample)")
     i.add_argument("--partial", action="store_true", help="also report the last incomplete segment")

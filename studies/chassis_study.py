@@ -172,15 +172,9 @@ def code_version() -> str:
         vehicle model invalidates the cached cases (``studies.sweep``'s default covers
         only this module).
     """
-    from eroad import __version__
+    from studies.sweep import code_version_of_files
 
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for pattern in _CODE_FILES:
-        for p in sorted(root.glob(pattern)):
-            h.update(p.relative_to(root).as_posix().encode())
-            h.update(p.read_bytes())
-    return f"eroad-{__version__}+{h.hexdigest()[:12]}"
+    return code_version_of_files(_CODE_FILES, Path(__file__).resolve().parents[1])
 
 
 # ---------------------------------------------------------------------------

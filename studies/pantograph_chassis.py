@@ -34,7 +34,6 @@ chassis study's equivalent roads are not driven here; one road, one speed per ru
 """
 from __future__ import annotations
 
-import hashlib
 import math
 import os
 import shutil
@@ -98,15 +97,9 @@ def code_version() -> str:
     this module, the contact study, the kinematics, the catenary and pantograph models
     and their data, the vehicle models and roadlib (a change of any of them invalidates
     the cached cases)."""
-    from eroad import __version__
+    from studies.sweep import code_version_of_files
 
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for pattern in _CODE_FILES:
-        for p in sorted(root.glob(pattern)):
-            h.update(p.relative_to(root).as_posix().encode())
-            h.update(p.read_bytes())
-    return f"eroad-{__version__}+{h.hexdigest()[:12]}"
+    return code_version_of_files(_CODE_FILES, Path(__file__).resolve().parents[1])
 
 
 def _frame_value(frame):
@@ -492,12 +485,8 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
     fig.suptitle(title or "Contact-force quality against frame and DCDC-mount stiffness",
                  fontsize=11)
     fig.tight_layout(rect=(0, 0, 1, 0.96))
-    p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(p, dpi=110)
-    fig.savefig(p.with_suffix(".pdf"))
-    plt.close(fig)
-    return [p, p.with_suffix(".pdf")]
+    from studies.pantograph_contact import save_png_pdf
+    return save_png_pdf(fig, path, dpi=110)
 
 
 def _summary(table, cases, sweep, road_label: str) -> dict:

@@ -256,9 +256,16 @@ def plot_contact(folder: str | Path, path: str | Path) -> list[Path]:
     ax[2].set_xlabel("time [s]")
     ax[2].legend(loc="upper right", fontsize=8)
     fig.tight_layout()
+    return save_png_pdf(fig, path, dpi=120)
+
+
+def save_png_pdf(fig, path, dpi: int = 120) -> list:
+    """Write ``fig`` as PNG at ``path`` and as PDF beside it, close it; the two paths."""
+    import matplotlib.pyplot as plt
+
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(p, dpi=120)
+    fig.savefig(p, dpi=dpi)
     fig.savefig(p.with_suffix(".pdf"))
     plt.close(fig)
     return [p, p.with_suffix(".pdf")]

@@ -46,6 +46,7 @@ __all__ = [
     "run_cases",
     "case_key",
     "code_version_of",
+    "code_version_of_files",
     "resolve_function",
     "dask_client",
     "add_sweep_arguments",
@@ -108,6 +109,25 @@ def resolve_function(func: str | CaseFunction) -> tuple[CaseFunction, str]:
         raise TypeError(f"case function {func!r} must be a top-level function "
                         "(no lambda or nested function)")
     return func, f"{module}:{qualname}"
+
+
+def code_version_of_files(patterns, root) -> str:
+    """Code-version token over source files: ``"eroad-<version>+<sha>"``, ``sha`` the
+    first 12 hex digits of the SHA-256 of each file's path relative to ``root`` and its
+    bytes, for the files matching ``patterns`` (globs relative to ``root``, the source
+    tree's top, each pattern's matches sorted).  For studies whose cases run code beyond
+    the case module (vehicle models, roads): pass it to :func:`run_cases` as
+    ``code_version``.
+    """
+    from eroad import __version__
+
+    root = Path(root)
+    h = hashlib.sha256()
+    for pattern in patterns:
+        for p in sorted(root.glob(pattern)):
+            h.update(p.relative_to(root).as_posix().encode())
+            h.update(p.read_bytes())
+    return f"eroad-{__version__}+{h.hexdigest()[:12]}"
 
 
 def code_version_of(func: str | CaseFunction) -> str:

@@ -11,24 +11,15 @@ of the stiff modes above ``--f-max``, energy shares of every mode) as JSON, atom
 """
 from __future__ import annotations
 
-import argparse
 import json
-import math
 import os
 import tempfile
 from pathlib import Path
 
+from eroad.argtypes import positive_float
 from eroad.errors import EroadInputError
 
 
-def _positive(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not (math.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
-    return v
 
 
 def _write_json_atomic(path: Path, doc, force: bool) -> None:
@@ -93,13 +84,13 @@ def register(subparsers) -> None:
                    help="built-in vehicle id (dump_truck_8x4, e_tractor) or a vehicle .toml file")
     p.add_argument("--chassis", choices=("rigid", "flexible"), default="rigid",
                    help="rigid chassis or flexible frame (default rigid)")
-    p.add_argument("--frame-stiffness", type=_positive, default=None, metavar="F",
+    p.add_argument("--frame-stiffness", type=positive_float, default=None, metavar="F",
                    help="scale of the frame's torsion and bending stiffness [-] (flexible; default 1)")
     p.add_argument("--frame-segments", type=int, default=None, metavar="N",
                    help="rigid segments of the flexible frame (default: the vehicle's)")
     p.add_argument("--effect", action="append", metavar="NAME=VALUE",
                    help="switch on an effect (configuration effects change the modes; repeatable)")
-    p.add_argument("--f-max", type=_positive, default=100.0, metavar="HZ",
+    p.add_argument("--f-max", type=positive_float, default=100.0, metavar="HZ",
                    help="list modes up to this frequency [Hz]; stiffer ones are only counted (100)")
     p.add_argument("--json", action="store_true",
                    help="print a JSON list of {label, freq_hz, damping, freq_damped_hz, freq_undamped_hz}")
