@@ -320,6 +320,10 @@ def main(argv=None) -> int:
     ap.add_argument("--no-default-effects", action="store_true",
                     help="truth vehicle without the scenario's leaf friction (no model gap but the "
                          "flexible frame and the finer step): the method's accuracy alone")
+    ap.add_argument("--effects-auto", action="store_true",
+                    help="invert as `eroad invert --effects auto` does: diagnose each drive first and "
+                         "invert with the effect a clear verdict names (the loop closed); the nominal "
+                         "inversion of the same drive is scored beside it (`nominal` rows)")
     a = ap.parse_args(argv)
     if a.measured_every and a.scenario != "second":
         ap.error("--measured-every needs --scenario second")
@@ -370,9 +374,13 @@ def main(argv=None) -> int:
             noise = {q: nz[key] for q, key in (("susp_disp", "susp_disp_m"), ("axle_acc", "axle_acc_mps2"),
                                                 ("body_acc", "body_acc_mps2"))}
         t0 = time.perf_counter()
-        summ = run_inversion(blind, root / f"run-{seed}", workers=a.workers, seed=0, candidates=0,
-                             max_iter=a.max_iter, channels=a.channels, force=True,
-                             polish=not a.no_polish, noise_sd=noise)
+        inv = dict(workers=a.workers, seed=0, candidates=0, max_iter=a.max_iter, channels=a.channels,
+                   force=True, polish=not a.no_polish, noise_sd=noise)
+        if a.effects_auto:
+            from diagnosis.closed_loop import invert_closed_loop
+            summ = invert_closed_loop(blind, root / f"run-{seed}", progress=lambda _m: None, **inv)
+        else:
+            summ = run_inversion(blind, root / f"run-{seed}", **inv)
         wall = time.perf_counter() - t0
         truth = read_truth(ds)
         if scen == "second_measured":   # no true ISO segment: the driven profile, fitted (measured_truth)
@@ -388,6 +396,11 @@ def main(argv=None) -> int:
                 r["oracle"] = o
         case.update(seed=seed, scenario=scen, wall_s=wall,
                     fit_model=summ.get("fit", {}).get("model"))
+        loop = summ.get("closed_loop")
+        if loop is not None:
+            case["closed_loop"] = {k: loop.get(k) for k in ("verdict", "confidence", "effects", "corrected")}
+            if loop.get("corrected") and scen != "second_measured":
+                case["nominal"] = score_case(truth, {"segments": loop["nominal_segments"]})["segments"]
         with res_file.open("a") as f:
             f.write(json.dumps(case) + "\n")
         done[seed] = case
