@@ -60,13 +60,18 @@ def profile_rows(case: dict, min_s: float = 3.0) -> list:
     return rows
 
 
-def load(root: Path, min_s: float = 3.0, profile: bool = False) -> list:
+def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool = False) -> list:
     """Rows of segments >= ``min_s`` (true segments; with ``profile`` the measured-road drives'
-    fitted segments against the profile instead, :func:`profile_rows`)."""
+    fitted segments against the profile instead, :func:`profile_rows`; with ``open_loop`` the
+    nominal inversion's rows where a closed-loop run (``bench_inverse.py --effects-auto``)
+    corrected the drive, i.e. the same drives inverted without the loop)."""
     rows = []
     for line in (root / "results.jsonl").read_text().splitlines():
         case = json.loads(line)
-        segs = profile_rows(case, min_s) if profile else case.get("segments", [])
+        if profile:
+            segs = profile_rows(case, min_s)
+        else:
+            segs = case.get("nominal") if open_loop and case.get("nominal") else case.get("segments", [])
         for r in segs:
             if r["duration_s"] >= min_s and "lnGq_err" in r:
                 r["seed"] = case["seed"]
@@ -151,6 +156,9 @@ def main(argv=None) -> int:
                     help="also score each set's scenarios apart (NAME/SCENARIO)")
     ap.add_argument("--profile", action="store_true",
                     help="also score measured-road drives per fitted segment against the profile (NAME/profile)")
+    ap.add_argument("--open-loop", action="store_true",
+                    help="for closed-loop sets (bench_inverse.py --effects-auto), also score the same "
+                         "drives' nominal inversions (NAME/open-loop)")
     a = ap.parse_args(argv)
     sets = {}
     for item in a.sets:
@@ -164,6 +172,8 @@ def main(argv=None) -> int:
             if len(scens) > 1:
                 for sc in scens:
                     extra[f"{name}/{sc}"] = [r for r in sets[name] if r["scenario"] == sc]
+        if a.open_loop and any(json.loads(li).get("nominal") for li in (root / "results.jsonl").read_text().splitlines()):
+            extra[f"{name}/open-loop"] = load(root, a.min_s, open_loop=True)
         if a.profile:
             pr = load(root, a.min_s, profile=True)
             if pr:
