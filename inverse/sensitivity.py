@@ -175,13 +175,62 @@ class SegmentFit:
     n_features: int
     converged: bool
     best_level: dict = field(default_factory=dict)
+    sd_robust: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         """JSON-ready dict."""
         return {**self.params, "class": self.cls, "dx": self.dx, "dy": self.dy,
                 "identifiable": self.identifiable, "sd": self.sd,
                 "singular_values": self.singular_values, "objective": self.objective,
-                "n_features": self.n_features, "converged": self.converged, **self.best_level}
+                "n_features": self.n_features, "converged": self.converged, **self.best_level,
+                **({"sd_robust": self.sd_robust} if self.sd_robust else {})}
+
+
+def robust_sd(J, w, e, prior_w, n_best: float | None = None, n0: float = N0) -> dict:
+    """Misspecification-robust ("sandwich") standard deviations of one segment's fit.
+
+    The Laplace covariance ``A^-1`` (``A = J^T W J + diag(prior_w)``) holds when the
+    weights are the features' true inverse variances and the model is right.  The
+    sandwich ``A^-1 B A^-1`` with ``B = J^T diag(w^2 e^2) J + diag(prior_w)`` replaces the
+    assumed variance of each feature by its squared residual (White's heteroscedasticity-
+    consistent covariance; Huber's estimator under a misspecified model): where the fit
+    leaves large residuals in the features that pin a parameter, that parameter's sd grows,
+    and residuals in features it does not depend on leave it alone.  With a correct model
+    E[w e^2] = 1 and B = A.  What it cannot see: a model error the parameters absorb
+    without leaving a residual.
+
+    Parameters
+    ----------
+    J : (m, P) array
+        Feature sensitivities d features / d theta at the fit.
+    w : (m,) array
+        Feature weights (inverse variances).
+    e : (m,) array
+        Residuals measured - fitted.
+    prior_w : (P,) array
+        Prior precisions of theta.
+    n_best : float, optional
+        Where ln Gd(n) = ln Gq_n0 - w ln(n / n0) is evaluated for ``ln_G_n_best``.
+
+    Returns
+    -------
+    dict
+        THETA_NAMES -> sd, plus ``ln_G_n_best`` when ``n_best`` is given.
+    """
+    J = np.asarray(J, float)
+    w = np.asarray(w, float)
+    e = np.asarray(e, float)
+    A = J.T @ (w[:, None] * J) + np.diag(prior_w)
+    Js = J * (w * e)[:, None]
+    B = Js.T @ Js + np.diag(prior_w)
+    Ai = np.linalg.inv(A)
+    C = Ai @ B @ Ai
+    out = dict(zip(THETA_NAMES, map(float, np.sqrt(np.maximum(np.diag(C), 0.0)))))
+    if n_best is not None:
+        g = np.zeros(J.shape[1])
+        g[0], g[1] = 1.0, -math.log(n_best / n0)
+        out["ln_G_n_best"] = float(math.sqrt(max(g @ C @ g, 0.0)))
+    return out
 
 
 def best_level(params: dict, cov: np.ndarray, n0: float = N0) -> dict:
@@ -591,10 +640,14 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
     for k in range(K):
         pk = dict(zip(PARAM_NAMES, map(float, params[k])))
         dx = grid_spacing(pk["nmax"])
+        best = best_level(pk, cov[k]) if np.all(np.isfinite(cov[k])) else {}
+        rob = {}
+        if J_last[k] is not None:
+            rob = robust_sd(J_last[k], W[k], np.asarray(y[k]) - np.asarray(Fc[k]), pw[k], best.get("n_best"))
         segs.append(SegmentFit(
             params=pk, cls=iso_class(pk["Gq_n0"]), dx=dx, dy=dx,
             identifiable=dict(zip(PARAM_NAMES, map(bool, ident[k]))),
             sd=dict(zip(THETA_NAMES, map(float, sd[k]))), singular_values=svals[k],
             objective=float(obj_data[k]), n_features=int(nf[k]), converged=bool(converged[k]),
-            best_level=best_level(pk, cov[k]) if np.all(np.isfinite(cov[k])) else {}))
+            best_level=best, sd_robust=rob))
     return FitResult(params, theta, segs, history, n_sims, _time.perf_counter() - t_start, Fc)
