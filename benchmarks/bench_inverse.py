@@ -232,7 +232,7 @@ def score_case(truth: dict, summary: dict) -> dict:
                      "lnGq_err": math.log(f["Gq_n0"] / s["Gq_n0"]), "w_err": f["w"] - s["w"],
                      "sd_ln_Gq_n0": f["sd"]["ln_Gq_n0"], "sd_w": f["sd"]["w"],
                      "sd_laplace": f.get("sd_laplace", f["sd"]),
-                     **({"sd_robust": f["sd_robust"]} if "sd_robust" in f else {}),
+                     **{key: f[key] for key in ("sd_robust", "consistency") if key in f},
                      "sd_ln_G_n_best_laplace": f.get("sd_ln_G_n_best_laplace", f.get("sd_ln_G_n_best")),
                      "fit_quality": f.get("fit_quality"),
                      "objective": f.get("objective"), "n_features": f.get("n_features"),

@@ -177,7 +177,7 @@ class Inversion:
                          "fit_quality": fit_quality(d["objective"], d["n_features"]),
                          "objective": d["objective"], "n_features": d["n_features"], "converged": d["converged"],
                          "at_bound": at_bounds(d["Gq_n0"], d["w"], self.config.bounds),
-                         **({"sd_robust": d["sd_robust"]} if "sd_robust" in d else {}),
+                         **{key: d[key] for key in ("sd_robust", "consistency") if key in d},
                          **best})
         return rows
 

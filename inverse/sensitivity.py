@@ -176,6 +176,7 @@ class SegmentFit:
     converged: bool
     best_level: dict = field(default_factory=dict)
     sd_robust: dict = field(default_factory=dict)
+    consistency: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         """JSON-ready dict."""
@@ -183,7 +184,8 @@ class SegmentFit:
                 "identifiable": self.identifiable, "sd": self.sd,
                 "singular_values": self.singular_values, "objective": self.objective,
                 "n_features": self.n_features, "converged": self.converged, **self.best_level,
-                **({"sd_robust": self.sd_robust} if self.sd_robust else {})}
+                **({"sd_robust": self.sd_robust} if self.sd_robust else {}),
+                **({"consistency": self.consistency} if self.consistency else {})}
 
 
 def robust_sd(J, w, e, prior_w, n_best: float | None = None, n0: float = N0) -> dict:
@@ -231,6 +233,67 @@ def robust_sd(J, w, e, prior_w, n_best: float | None = None, n0: float = N0) -> 
         g[0], g[1] = 1.0, -math.log(n_best / n0)
         out["ln_G_n_best"] = float(math.sqrt(max(g @ C @ g, 0.0)))
     return out
+
+
+def channel_kind(label: str) -> str:
+    """A feature label's channel kind: 'susp_disp_3L@2.00Hz' -> 'susp_disp'."""
+    return label.split("@")[0].split(":")[0].rsplit("_", 1)[0]
+
+
+def channel_consistency(J, w, e, prior_w, labels, n_best: float | None = None, n0: float = N0) -> dict:
+    """How far the channel kinds of one segment pull the fit apart (a model-form measure).
+
+    From the joint fit, one Gauss-Newton step with the features of ONE channel kind
+    (suspension displacement, axle acceleration, ...) gives where that kind alone would
+    put the parameters: ``d_g = (J_g^T W_g J_g + P)^-1 J_g^T W_g e_g``.  With a correct model
+    the kinds agree within noise: ``E[d_g^2] = v_g``, the difference of the kind-alone and
+    the joint Laplace variances.  A vehicle the model lacks (leaf friction stiffens the
+    suspension: the displacements say "smoother road", the axle accelerations do not)
+    pulls the kinds apart by about the bias it puts into the joint fit, whether or not
+    it leaves a residual.  Returned per quantity: the excess ``mean_g max(0, d_g^2 - v_g)``
+    [ln^2 or -^2], the model-form variance :mod:`inverse.uncertainty` may add.
+
+    Parameters
+    ----------
+    J : (m, P) array
+        Feature sensitivities at the fit.
+    w, e : (m,) arrays
+        Feature weights (inverse variances) and residuals measured - fitted.
+    prior_w : (P,) array
+        Prior precisions.
+    labels : list of str
+        Feature labels (``WindowFeatures.labels``).
+    n_best : float, optional
+        Where ``ln_G_n_best`` is evaluated.
+
+    Returns
+    -------
+    dict
+        ``excess`` {quantity: variance}, ``kinds`` {kind: {quantity: step}}; empty
+        ``excess`` when fewer than two kinds are fitted.
+    """
+    J, w, e = (np.asarray(a, float) for a in (J, w, e))
+    kinds = np.array([channel_kind(lab) for lab in labels])
+    names = list(THETA_NAMES)
+    G = np.eye(J.shape[1])
+    if n_best is not None:
+        g = np.zeros(J.shape[1])
+        g[0], g[1] = 1.0, -math.log(n_best / n0)
+        G = np.vstack([G, g])
+        names.append("ln_G_n_best")
+    P = np.diag(prior_w)
+    A_inv = np.linalg.inv(J.T @ (w[:, None] * J) + P)
+    out_k, ex = {}, []
+    for kind in sorted(set(kinds)):
+        m = kinds == kind
+        Jg, wg = J[m], w[m]
+        Ag_inv = np.linalg.inv(Jg.T @ (wg[:, None] * Jg) + P)
+        d = G @ (Ag_inv @ (Jg.T @ (wg * e[m])))
+        v = np.einsum("ij,jk,ik->i", G, Ag_inv - A_inv, G)
+        out_k[str(kind)] = dict(zip(names, map(float, d)))
+        ex.append(np.maximum(d ** 2 - np.maximum(v, 0.0), 0.0))
+    excess = dict(zip(names, map(float, np.mean(ex, axis=0)))) if len(out_k) >= 2 else {}
+    return {"excess": excess, "kinds": out_k}
 
 
 def best_level(params: dict, cov: np.ndarray, n0: float = N0) -> dict:
@@ -641,13 +704,15 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
         pk = dict(zip(PARAM_NAMES, map(float, params[k])))
         dx = grid_spacing(pk["nmax"])
         best = best_level(pk, cov[k]) if np.all(np.isfinite(cov[k])) else {}
-        rob = {}
+        rob, cons = {}, {}
         if J_last[k] is not None:
-            rob = robust_sd(J_last[k], W[k], np.asarray(y[k]) - np.asarray(Fc[k]), pw[k], best.get("n_best"))
+            res = np.asarray(y[k]) - np.asarray(Fc[k])
+            rob = robust_sd(J_last[k], W[k], res, pw[k], best.get("n_best"))
+            cons = channel_consistency(J_last[k], W[k], res, pw[k], features.windows[k].labels, best.get("n_best"))
         segs.append(SegmentFit(
             params=pk, cls=iso_class(pk["Gq_n0"]), dx=dx, dy=dx,
             identifiable=dict(zip(PARAM_NAMES, map(bool, ident[k]))),
             sd=dict(zip(THETA_NAMES, map(float, sd[k]))), singular_values=svals[k],
             objective=float(obj_data[k]), n_features=int(nf[k]), converged=bool(converged[k]),
-            best_level=best, sd_robust=rob))
+            best_level=best, sd_robust=rob, consistency=cons))
     return FitResult(params, theta, segs, history, n_sims, _time.perf_counter() - t_start, Fc)
