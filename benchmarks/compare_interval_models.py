@@ -11,7 +11,9 @@ on every set with that factor, i.e. out of sample on all but the calibration set
 * ``laplace``: the Laplace sd alone, scaled;
 * ``robust``: the sandwich sd of ``inverse.sensitivity.robust_sd`` (``sd_robust`` in the
   records), scaled;
-* ``robust+beta``: sqrt((k sd_robust)^2 + BETA max(0, r / R_REF - 1)).
+* ``robust+beta``: sqrt((k sd_robust)^2 + BETA max(0, r / R_REF - 1));
+* ``misfit+consistency``: the misfit model's variance plus the channel-kind spread beyond
+  noise (``consistency.excess`` of ``inverse.sensitivity.channel_consistency``; 0 where absent).
 
 Run:  python benchmarks/compare_interval_models.py null=R1 random=R2 second=R3 --calibrate null
 Nothing is written; the printout is what a results README quotes.
@@ -46,6 +48,9 @@ MODELS = {
     "laplace": lambda r, q, k: k * _lap(r, q),
     "robust": lambda r, q, k: k * r["sd_robust"][q],
     "robust+beta": lambda r, q, k: float(np.sqrt((k * r["sd_robust"][q]) ** 2 + U.BETA[q] * _excess(r))),
+    "misfit+consistency": lambda r, q, k: float(np.sqrt(
+        U.reported_sd(_lap(r, q), misfit(r), q, kappa={**U.KAPPA, q: k}) ** 2
+        + r.get("consistency", {}).get("excess", {}).get(q, 0.0))),
 }
 
 
