@@ -999,6 +999,17 @@ def _set_terms(sc, terms, n_null: int) -> list:
     return sur
 
 
+def two_input_or_none(measured, simulated):
+    """:func:`diagnosis.compare.transmissibility_two_input` of two records, or None where no
+    station has both axle accelerations and a body acceleration (the signature then falls
+    back to the single-input transmissibility, :func:`diagnosis.verdict.chosen_signature`)."""
+    from diagnosis.compare import transmissibility_two_input, two_input_stations
+
+    if not two_input_stations(measured, simulated):
+        return None
+    return transmissibility_two_input(measured, simulated)
+
+
 def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quick: bool = False,
              force: bool = False, seed: int = 0, n_windows: int = 4, settings=None,
              road_fit: str = "levels", progress=_say) -> dict:
@@ -1044,7 +1055,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
 
     from diagnosis.compare import distribution_shape, front_rear, transmissibility
     from diagnosis.report import write_report
-    from diagnosis.verdict import search_ranges, signature
+    from diagnosis.verdict import SIGNATURE_METHOD, search_ranges, signature
     from diagnosis.which import combine_folds, rank_effects
     from diagnosis.where import localize
     from vehicles.params import load_vehicle
@@ -1078,6 +1089,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     loc = localize(sig, sim, segments=segs)
     wheelbase = float(vp.axles[0].x - vp.axles[2].x) if len(vp.axles) >= 3 else None
     tr = transmissibility(sig, sim)
+    tr2 = two_input_or_none(sig, sim)
     fr = front_rear(sig, sim, wheelbase=wheelbase)
     sh = distribution_shape(sig, sim)
     timing["localization_s"] = _time.perf_counter() - t
@@ -1112,14 +1124,20 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     timing["ranking_s"] = _time.perf_counter() - t
 
     # the winner's road-independent signature: its axle-to-body transmissibility on the
-    # nominal model's road and seed, against the measurement (diagnosis.verdict)
-    sig_w = None
+    # nominal model's road and seed, against the measurement (diagnosis.verdict); both the
+    # single-input ratio (``signature``, as before) and the two-input estimate
+    # (``signature_two_input``, where both sides are measured); the verdict uses
+    # diagnosis.verdict.SIGNATURE_METHOD
+    sig_w = sig_w2 = None
     if ranking.winner is not None:
         t = _time.perf_counter()
         simw = model.run(ranking.winner.effects, 0.0, T, seed + 1)
         simw = Signals(sig.time, model.add_noise(simw, seed + 1), dict(sig.units), sig.speed,
                        {"model": ranking.winner.effect})
         sig_w = signature(ranking.winner.effect, tr, transmissibility(sig, simw))
+        tr2w = two_input_or_none(sig, simw) if tr2 is not None else None
+        if tr2w is not None:
+            sig_w2 = signature(ranking.winner.effect, tr2, tr2w, method="two_input")
         timing["signature_s"] = _time.perf_counter() - t
     timing["total_s"] = _time.perf_counter() - wall0
 
@@ -1144,11 +1162,13 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         "noise_std": model.noise, "wheelbase_m": wheelbase, "quick": bool(quick), "seed": int(seed),
         "workers": int(workers), "candidates": [c.name for c in cands],
         "search_ranges": search_ranges(cands),
+        "signature_method": SIGNATURE_METHOD,
         "ranking_settings": {**{k: v for k, v in kw.items()}, "folds": folds},
         "timing": {k: round(v, 2) for k, v in timing.items()},
     }
     write_report(out, localization=loc, transmissibility=tr, front_rear=fr, shape=sh,
-                 ranking=ranking, meta=meta, force=force, signature=sig_w)
+                 ranking=ranking, meta=meta, force=force, signature=sig_w,
+                 transmissibility_two_input=tr2, signature_two_input=sig_w2)
     write_run_json(out, finish_run_info(record, "complete", wall_s=_time.perf_counter() - wall0))
     summary = json.loads((out / "summary.json").read_text())
     progress(f"verdict: {summary['verdict']} ({summary['verdict_confidence']}); "

@@ -13,7 +13,12 @@ a pair, or ``"none"``), ``verdict_confidence``, ``verdict_reason``,
 significant, ci_lo, ci_hi, ...}), ``localization_settings``, ``ranking`` (best
 first, list of {effect, parameters, heldout_gap_before, heldout_gap_after,
 shrink_fraction, shrink_spread, ...}), ``nominal``, ``how_far``,
-``transmissibility``, ``front_rear``, ``distribution``, ``meta``.
+``transmissibility``, ``front_rear``, ``distribution``, ``meta``.  Where computed:
+``transmissibility_two_input`` (the two-input estimate of
+``diagnosis.compare.transmissibility_two_input``, nominal model against the measurement),
+``signature`` (the ranking winner's single-input transmissibility against the
+measurement) and ``signature_two_input`` (its two-input one); ``verdict_detail`` names
+the one the verdict used (``signature_method``).
 
 What it is not: the command line (``diagnosis.cli``) or any computation.
 """
@@ -58,7 +63,8 @@ def jsonable(obj: Any) -> Any:
 
 
 def build_summary(localization=None, *, transmissibility=None, front_rear=None, shape=None,
-                  ranking=None, meta: Mapping | None = None, signature=None) -> dict:
+                  ranking=None, meta: Mapping | None = None, signature=None,
+                  transmissibility_two_input=None, signature_two_input=None) -> dict:
     """Machine-readable summary of a diagnosis.
 
     Parameters
@@ -72,6 +78,9 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
         Dataset, vehicle, command line, versions... copied under ``meta``.
     signature : diagnosis.verdict.Signature, optional
         Transmissibility of the ranking's winner against the measurement.
+    transmissibility_two_input : diagnosis.compare.TwoInputTransmissibility, optional
+    signature_two_input : diagnosis.verdict.Signature, optional
+        The same with the two-input transmissibility (``method="two_input"``).
 
     The verdict is :func:`diagnosis.verdict.decide` on this summary (the ranking's own
     decision is kept under ``ranking_decision``).
@@ -101,6 +110,16 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
         s["transmissibility"] = {"q": transmissibility.q, "ci_level": transmissibility.ci_level,
                                  "pairs": [list(p) for p in transmissibility.pairs],
                                  "cells": transmissibility.records()}
+    if transmissibility_two_input is not None:
+        T2 = transmissibility_two_input
+        s["transmissibility_two_input"] = {
+            "q": T2.q, "ci_level": T2.ci_level, "pairs": [list(p) for p in T2.pairs],
+            "conditioned_on": list(T2.conditioned_on), "n_unresolved": T2.n_unresolved,
+            "method": "body_acc of a station on both axle_acc of that station, "
+                      "H = S_xx^-1 S_xy per bin (Welch segments weighted by their input power), "
+                      "band mean of ln|H|; bands whose two inputs are nearly fully coherent are "
+                      "not resolved",
+            "cells": T2.records()}
     if front_rear is not None:
         s["front_rear"] = front_rear.records()
     if shape is not None:
@@ -134,6 +153,8 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
                              for i, b in enumerate(R.bands)]}
         if signature is not None:
             s["signature"] = signature.record()
+        if signature_two_input is not None:
+            s["signature_two_input"] = signature_two_input.record()
         s = jsonable(s)
         d = decide(s)
         s["verdict"], s["verdict_confidence"], s["verdict_reason"] = (d["verdict"], d["confidence"],
@@ -380,12 +401,21 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
             L.append(" Bands furthest above the sampling floor: "
                      + ", ".join(f"{b['band_centre_hz']:.3g} Hz ({b['gap']:.3g} against "
                                  f"{b['sampling_floor']:.3g})" for b in R["bands_left"]) + ".")
-        S = summary.get("signature")
-        if S:
-            L.append(f" Axle-to-body transmissibility against the measurement (mean z^2 over "
-                     f"{S['n_cells']} cells; about 1 for a correct model): nominal "
-                     f"{_fmt(S['chi2_nominal'])}, with {S['model']} {_fmt(S['chi2_model'])}"
+        used = D.get("signature_method")
+        for key, what in (("signature_two_input", "Two-input axle-to-body transmissibility "
+                                                  "(body on both axles of its station)"),
+                          ("signature", "Axle-to-body transmissibility (single input)")):
+            S = summary.get(key)
+            if not S:
+                continue
+            tag = S.get("method", "single_input")
+            L.append(f" {what} against the measurement (mean z^2 over {S['n_cells']} cells; "
+                     f"about 1 for a correct model): nominal {_fmt(S['chi2_nominal'])}, with "
+                     f"{S['model']} {_fmt(S['chi2_model'])}"
+                     + (f", {S['n_unresolved']} cells not resolved (inputs too coherent)"
+                        if S.get("n_unresolved") else "")
                      + (f"; still off: {', '.join(S['pairs_off'])}" if S.get("pairs_off") else "")
+                     + ("; the verdict uses this one" if tag == used else "; not used by the verdict")
                      + ".")
         if D.get("edge"):
             L.append(f" Calibrated at the edge of the search range: {', '.join(D['edge'])}.")
@@ -430,6 +460,18 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
         L.append("")
         if "transmissibility" in figures:
             L.append(f"![transmissibility]({figures['transmissibility']})\n")
+    T2 = summary.get("transmissibility_two_input")
+    if T2:
+        L.append("**Two-input axle-to-body transmissibility** (ln|H_sim| - ln|H_meas|, body "
+                 "acceleration of a station on both of its axle accelerations; "
+                 f"{T2['n_unresolved']} pair x band cells not resolved: inputs too coherent):\n")
+        for (a, b), c in zip(T2["pairs"], T2["conditioned_on"]):
+            fl = [r["band_centre_hz"] for r in T2["cells"] if r["input"] == a and r["output"] == b
+                  and r["significant"]]
+            L.append(f"- {a} -> {b} (given {c}): "
+                     + (f"flagged at {', '.join(f'{f:.3g}' for f in fl)} Hz" if fl
+                        else "no flagged band"))
+        L.append("")
     FR = summary.get("front_rear")
     if FR:
         L.append("**Front-to-rear delay** (GCC-SCOT of the lag in recorded distance, shown as a "
@@ -525,14 +567,16 @@ def _terms_text(settings: Mapping) -> str:
 
 def write_report(out: str | os.PathLike, *, localization=None, transmissibility=None,
                  front_rear=None, shape=None, ranking=None, meta: Mapping | None = None,
-                 force: bool = False, signature=None) -> Path:
+                 force: bool = False, signature=None, transmissibility_two_input=None,
+                 signature_two_input=None) -> Path:
     """Write ``summary.json``, ``figures/*.png`` and ``report.md`` into ``out``.
 
     Parameters
     ----------
     out : path
         Run folder; refused if it exists and is not empty unless ``force``.
-    localization, transmissibility, front_rear, shape, ranking, meta, signature
+    localization, transmissibility, front_rear, shape, ranking, meta, signature,
+    transmissibility_two_input, signature_two_input
         As for :func:`build_summary`.
     force : bool
         Replace an existing non-empty ``out`` (only after the new one is complete).
@@ -546,7 +590,9 @@ def write_report(out: str | os.PathLike, *, localization=None, transmissibility=
     if out.exists() and (not out.is_dir() or any(out.iterdir())) and not force:
         raise EroadInputError(f"{out} exists and is not empty (use --force to replace it)")
     summary = build_summary(localization, transmissibility=transmissibility, front_rear=front_rear,
-                            shape=shape, ranking=ranking, meta=meta, signature=signature)
+                            shape=shape, ranking=ranking, meta=meta, signature=signature,
+                            transmissibility_two_input=transmissibility_two_input,
+                            signature_two_input=signature_two_input)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
     try:

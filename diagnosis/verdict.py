@@ -27,7 +27,11 @@ Vocabulary
        of one record: the road cancels) matches the measurement to within
        ``SIGNATURE_CHI2_MAX`` (mean z^2 over the tested pair x band cells; about 1 for a
        correct model) -- or, where the nominal model's is off, removes at least
-       ``SIGNATURE_SHARE_MIN`` of its excess (:func:`signature_agrees`).  ``identified``
+       ``SIGNATURE_SHARE_MIN`` of its excess (:func:`signature_agrees`).  Which
+       transmissibility: ``SIGNATURE_METHOD`` (default ``single_input``; ``two_input``: a
+       station's body acceleration on both of its axle accelerations, which the cross-track
+       coherence of the road does not enter, with the single-input ratio where a summary has
+       no two-input record, :func:`chosen_signature`; not the default yet, docs/diagnosis.md).  ``identified``
     (in the result) is True when the named effect's identity and value are not in doubt
     (no close rival, no range edge) even if a remainder keeps it from "clear": the
     closed loop (``diagnosis.closed_loop``) corrects with such an effect.  The front-to-rear delay and the amplitude distribution
@@ -72,12 +76,33 @@ SIGNATURE_SHARE_MIN = 0.15
 #: a calibrated parameter within this share of its search range (unit coordinates, log
 #: where searched in log) of either end is "at the edge"
 EDGE_TOL = 0.02
+#: which axle-to-body transmissibility the signature test (3.) uses: ``"two_input"``
+#: (:func:`diagnosis.compare.transmissibility_two_input`: body acceleration of a station on
+#: BOTH axle accelerations of that station, which does not depend on the road's cross-track
+#: coherence) where the summary holds it (``signature_two_input``), else -- and with
+#: ``"single_input"`` -- the single-input ratio (:func:`diagnosis.compare.transmissibility`,
+#: ``signature``), which on a four-axle truck still depends on the road
+#: (docs/diagnosis.md, "Signature: two-input transmissibility")
+SIGNATURE_METHOD = "single_input"
+SIGNATURE_METHODS = ("two_input", "single_input")
+
+
+_MEASURE = {
+    "single_input": "mean of ((ln|H_meas| - ln|H_sim|) / se)^2 over tested pair x band cells, "
+                    "axle to body acceleration per wheel position",
+    "two_input": "mean of ((ln|H_meas| - ln|H_sim|) / se)^2 over tested cells (input, output) x "
+                 "band, body acceleration of a station on both axle accelerations of that station "
+                 "(H = S_xx^-1 S_xy per bin); bands whose two inputs are nearly fully coherent "
+                 "are not resolved and not tested"}
 
 
 @dataclass(frozen=True)
 class Signature:
     """Axle-to-body transmissibility of the nominal and of the candidate model against the
-    measurement: mean z^2 over the tested cells and the number flagged (BH)."""
+    measurement: mean z^2 over the tested cells and the number flagged (BH).  ``method``:
+    ``single_input`` (:func:`diagnosis.compare.transmissibility`) or ``two_input``
+    (:func:`diagnosis.compare.transmissibility_two_input`; ``n_unresolved`` cells of the
+    candidate's comparison not resolved)."""
 
     model: str
     chi2_nominal: float
@@ -86,14 +111,18 @@ class Signature:
     flagged_nominal: int
     flagged_model: int
     pairs_off: tuple = ()
+    method: str = "single_input"
+    n_unresolved: int | None = None
 
     def record(self) -> dict:
-        return {"model": self.model, "chi2_nominal": _f(self.chi2_nominal),
-                "chi2_model": _f(self.chi2_model), "n_cells": int(self.n_cells),
-                "flagged_nominal": int(self.flagged_nominal),
-                "flagged_model": int(self.flagged_model), "pairs_off": list(self.pairs_off),
-                "measure": "mean of ((ln|H_meas| - ln|H_sim|) / se)^2 over tested pair x band "
-                           "cells, axle to body acceleration per wheel position"}
+        out = {"model": self.model, "chi2_nominal": _f(self.chi2_nominal),
+               "chi2_model": _f(self.chi2_model), "n_cells": int(self.n_cells),
+               "flagged_nominal": int(self.flagged_nominal),
+               "flagged_model": int(self.flagged_model), "pairs_off": list(self.pairs_off),
+               "measure": _MEASURE[self.method], "method": self.method}
+        if self.n_unresolved is not None:
+            out["n_unresolved"] = int(self.n_unresolved)
+        return out
 
 
 def _f(v):
@@ -112,10 +141,33 @@ def transmissibility_chi2(tr) -> tuple[float, int, int, tuple]:
     return (float(np.mean(z[ok] ** 2)) if n else float("nan")), n, int(sig.sum()), pairs
 
 
-def signature(model_name: str, tr_nominal, tr_model) -> Signature:
+def signature(model_name: str, tr_nominal, tr_model, method: str = "single_input") -> Signature:
+    """:class:`Signature` of a candidate from the nominal model's and the candidate's
+    transmissibility against the measurement (``Transmissibility`` for ``single_input``,
+    ``TwoInputTransmissibility`` for ``two_input``)."""
+    if method not in SIGNATURE_METHODS:
+        raise ValueError(f"method must be one of {', '.join(SIGNATURE_METHODS)}, got {method!r}")
     c0, n0, f0, _ = transmissibility_chi2(tr_nominal)
     c1, n1, f1, p1 = transmissibility_chi2(tr_model)
-    return Signature(model_name, c0, c1, min(n0, n1), f0, f1, p1)
+    nu = getattr(tr_model, "n_unresolved", None) if method == "two_input" else None
+    return Signature(model_name, c0, c1, min(n0, n1), f0, f1, p1, method, nu)
+
+
+def chosen_signature(summary: Mapping, method: str = SIGNATURE_METHOD) -> tuple[dict, str]:
+    """The signature record the verdict uses and its method: ``summary["signature_two_input"]``
+    for ``two_input`` when it holds both numbers and at least one tested cell, else
+    ``summary["signature"]`` (single input; what summaries before the two-input estimate
+    hold, and the fallback where no station has both axle accelerations or no band is
+    resolved)."""
+    if method not in SIGNATURE_METHODS:
+        raise ValueError(f"signature_method must be one of {', '.join(SIGNATURE_METHODS)}, "
+                         f"got {method!r}")
+    if method == "two_input":
+        s2 = summary.get("signature_two_input") or {}
+        if (s2.get("chi2_nominal") is not None and s2.get("chi2_model") is not None
+                and (s2.get("n_cells") or 0) > 0):
+            return s2, "two_input"
+    return summary.get("signature") or {}, "single_input"
 
 
 def edge_parameters(params: Mapping, ranges: Mapping, tol: float = EDGE_TOL) -> list[str]:
@@ -197,18 +249,21 @@ def signature_agrees(c0, c1, signature_max: float = SIGNATURE_CHI2_MAX,
 
 def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
            signature_max: float = SIGNATURE_CHI2_MAX,
-           signature_share: float = SIGNATURE_SHARE_MIN) -> dict:
+           signature_share: float = SIGNATURE_SHARE_MIN,
+           signature_method: str = SIGNATURE_METHOD) -> dict:
     """Verdict, confidence, reason and what is left, from a diagnosis summary.
 
     Reads ``summary["ranking"]`` (entries, accepted first), ``summary["ranking_decision"]``
-    (the ranking's own verdict and confidence), ``summary["nominal"]``,
-    ``summary.get("signature")`` and ``summary["meta"]["search_ranges"]``.
+    (the ranking's own verdict and confidence), ``summary["nominal"]``, the signature
+    record :func:`chosen_signature` picks for ``signature_method`` (``signature_two_input``
+    or ``signature``) and ``summary["meta"]["search_ranges"]``.
 
     Returns
     -------
     dict with ``verdict``, ``confidence``, ``reason``, ``explained_share``,
     ``closest`` (effect or None), ``edge`` (list), ``signature_agrees`` (bool or None),
-    ``residual`` (see :func:`residual`), ``thresholds``.
+    ``signature_method`` (the transmissibility used), ``residual`` (see :func:`residual`),
+    ``thresholds``.
     """
     nom = summary.get("nominal") or {}
     rd = summary.get("ranking_decision") or {}
@@ -218,9 +273,11 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     rv = rd.get("verdict", "none")
     win = next((e for e in ranking if e.get("effect") == rv and e.get("accepted")), None)
     thresholds = {"share_min": share_min, "signature_chi2_max": signature_max,
-                  "signature_share_min": signature_share, "edge_tol": EDGE_TOL}
+                  "signature_share_min": signature_share, "edge_tol": EDGE_TOL,
+                  "signature_method": signature_method}
+    sig, sig_method = chosen_signature(summary, signature_method)
     base = {"explained_share": None, "closest": None, "edge": [], "signature_agrees": None,
-            "identified": False,
+            "signature_method": sig_method if sig else None, "identified": False,
             "thresholds": thresholds, "ranking_verdict": rv,
             "ranking_confidence": rd.get("confidence", "none")}
     if win is None:
@@ -240,14 +297,15 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
                     residual=residual(summary, None))
     share = explained_share(win, nom)
     edges = _entry_edges(win, ranges)
-    sig = summary.get("signature") or {}
     c0, c1 = sig.get("chi2_nominal"), sig.get("chi2_model")
+    what = ("two-input axle-to-body transmissibility" if sig_method == "two_input"
+            else "axle-to-body transmissibility")
     agrees = signature_agrees(c0, c1, signature_max, signature_share)
     out = dict(base, explained_share=_f(share), closest=win["effect"], edge=edges,
                signature_agrees=agrees, residual=residual(summary, win))
     remainder = ""
     if agrees and c1 is not None and c1 > signature_max:
-        remainder = (f"; its transmissibility moves towards the measurement (mean z^2 {c0:.2g} "
+        remainder = (f"; its {what} moves towards the measurement (mean z^2 {c0:.2g} "
                      f"-> {c1:.2g}) but stays off: a difference beyond it remains")
     short = []
     if not (share >= share_min):
@@ -255,7 +313,7 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
                      f"(at least {share_min:.0%} asked)" if math.isfinite(share) else
                      "its share of the gap above a correct model's is undefined")
     if agrees is False:
-        short.append(f"its axle-to-body transmissibility still disagrees with the measurement "
+        short.append(f"its {what} still disagrees with the measurement "
                      f"(mean z^2 {c1:.2g}, nominal {c0:.2g}, at most {signature_max:g} asked"
                      + (f"; off: {', '.join(sig.get('pairs_off', [])[:4])}" if sig.get("pairs_off")
                         else "") + ")")
@@ -269,7 +327,7 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     reason = rd.get("reason") or ""
     reason += (f"; it explains {share:.0%} of the gap above a correct model's"
                + ("" if agrees is None or remainder else
-                  "; its transmissibility agrees with the measurement")
+                  f"; its {what} agrees with the measurement")
                + remainder)
     if remainder and conf == "clear":
         conf = "ambiguous"
