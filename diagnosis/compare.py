@@ -481,8 +481,8 @@ def two_input_response(x1: np.ndarray, x2: np.ndarray, y: np.ndarray, fs: float,
     return TwoInputResponse(bands, T, V, GM, GP, G12, res, ill, NE)
 
 
-@dataclass(frozen=True)
-class TwoInputTransmissibility:
+@dataclass(frozen=True, kw_only=True)
+class TwoInputTransmissibility(Transmissibility):
     """Two-input axle-to-body transmissibility, measured against simulated, per band.
 
     One cell per (input, output) x band: ``output = body_acc_<i><S>``, inputs the two axle
@@ -512,27 +512,13 @@ class TwoInputTransmissibility:
     q, ci_level : float
     """
 
-    pairs: list
     conditioned_on: list
-    bands: np.ndarray
-    log_mag_meas: np.ndarray
-    log_mag_sim: np.ndarray
-    coherence_meas: np.ndarray
-    coherence_sim: np.ndarray
     partial_coherence_meas: np.ndarray
     partial_coherence_sim: np.ndarray
     input_coherence_meas: np.ndarray
     input_coherence_sim: np.ndarray
     resolved: np.ndarray
     ill_conditioned: np.ndarray
-    log_ratio: np.ndarray
-    se: np.ndarray
-    ci_lo: np.ndarray
-    ci_hi: np.ndarray
-    p_value: np.ndarray
-    significant: np.ndarray
-    q: float
-    ci_level: float
 
     @property
     def n_unresolved(self) -> int:
@@ -541,25 +527,18 @@ class TwoInputTransmissibility:
         return int(self.ill_conditioned.sum())
 
     def records(self) -> list[dict]:
-        """JSON-ready list, one dict per pair x band (``resolved`` False: inputs too coherent)."""
-        out = []
-        for i, (a, b) in enumerate(self.pairs):
-            for j, (lo, fc, hi) in enumerate(self.bands):
-                out.append({"input": a, "output": b, "conditioned_on": self.conditioned_on[i],
-                            "band_hz": [float(lo), float(hi)], "band_centre_hz": float(fc),
-                            "resolved": bool(self.resolved[i, j]),
-                            "ill_conditioned": bool(self.ill_conditioned[i, j]),
-                            "log_mag_meas": _num(self.log_mag_meas[i, j]),
-                            "log_mag_sim": _num(self.log_mag_sim[i, j]),
-                            "coherence_meas": _num(self.coherence_meas[i, j]),
-                            "coherence_sim": _num(self.coherence_sim[i, j]),
-                            "partial_coherence_meas": _num(self.partial_coherence_meas[i, j]),
-                            "partial_coherence_sim": _num(self.partial_coherence_sim[i, j]),
-                            "input_coherence_meas": _num(self.input_coherence_meas[i, j]),
-                            "input_coherence_sim": _num(self.input_coherence_sim[i, j]),
-                            "log_ratio": _num(self.log_ratio[i, j]), "ci_lo": _num(self.ci_lo[i, j]),
-                            "ci_hi": _num(self.ci_hi[i, j]), "p_value": _num(self.p_value[i, j]),
-                            "significant": bool(self.significant[i, j])})
+        """JSON-ready list, one dict per pair x band: :meth:`Transmissibility.records` plus the
+        conditioning input, ``resolved`` (False: inputs too coherent) and the coherences."""
+        out = super().records()
+        nb = len(self.bands)
+        for n, rec in enumerate(out):
+            i, j = divmod(n, nb)
+            rec.update({"conditioned_on": self.conditioned_on[i], "resolved": bool(self.resolved[i, j]),
+                        "ill_conditioned": bool(self.ill_conditioned[i, j]),
+                        "partial_coherence_meas": _num(self.partial_coherence_meas[i, j]),
+                        "partial_coherence_sim": _num(self.partial_coherence_sim[i, j]),
+                        "input_coherence_meas": _num(self.input_coherence_meas[i, j]),
+                        "input_coherence_sim": _num(self.input_coherence_sim[i, j])})
         return out
 
 
@@ -665,9 +644,12 @@ def transmissibility_two_input(measured, simulated, *, stations=None,
     d = np.where(tested, s["T"] - m["T"], np.nan)
     se = np.where(tested, np.sqrt(s["V"] + m["V"] + 2 * se_floor ** 2), np.nan)
     p, sig, lo, hi, level = _flag(d, se, q)
-    return TwoInputTransmissibility(pairs, cond, bands, m["T"], s["T"], m["G"], s["G"], m["P"], s["P"],
-                                    m["C"], s["C"], resolved, ill, d, se, lo, hi, p, sig, float(q),
-                                    float(level))
+    return TwoInputTransmissibility(
+        pairs=pairs, bands=bands, log_mag_meas=m["T"], log_mag_sim=s["T"], coherence_meas=m["G"],
+        coherence_sim=s["G"], log_ratio=d, se=se, ci_lo=lo, ci_hi=hi, p_value=p, significant=sig,
+        q=float(q), ci_level=float(level), conditioned_on=cond, partial_coherence_meas=m["P"],
+        partial_coherence_sim=s["P"], input_coherence_meas=m["C"], input_coherence_sim=s["C"],
+        resolved=resolved, ill_conditioned=ill)
 
 
 # ----------------------------------------------------------------------------- front to rear
