@@ -229,10 +229,16 @@ def robust_sd(J, w, e, prior_w, n_best: float | None = None, n0: float = N0) -> 
     C = Ai @ B @ Ai
     out = dict(zip(THETA_NAMES, map(float, np.sqrt(np.maximum(np.diag(C), 0.0)))))
     if n_best is not None:
-        g = np.zeros(J.shape[1])
-        g[0], g[1] = 1.0, -math.log(n_best / n0)
+        g = level_gradient(J.shape[1], n_best, n0)
         out["ln_G_n_best"] = float(math.sqrt(max(g @ C @ g, 0.0)))
     return out
+
+
+def level_gradient(n_params: int, n: float, n0: float = N0) -> np.ndarray:
+    """Gradient of ln Gd(n) = ln Gq_n0 - w ln(n / n0) with respect to theta (length ``n_params``)."""
+    g = np.zeros(n_params)
+    g[0], g[1] = 1.0, -math.log(n / n0)
+    return g
 
 
 def channel_kind(label: str) -> str:
@@ -277,9 +283,7 @@ def channel_consistency(J, w, e, prior_w, labels, n_best: float | None = None, n
     names = list(THETA_NAMES)
     G = np.eye(J.shape[1])
     if n_best is not None:
-        g = np.zeros(J.shape[1])
-        g[0], g[1] = 1.0, -math.log(n_best / n0)
-        G = np.vstack([G, g])
+        G = np.vstack([G, level_gradient(J.shape[1], n_best, n0)])
         names.append("ln_G_n_best")
     P = np.diag(prior_w)
     A_inv = np.linalg.inv(J.T @ (w[:, None] * J) + P)
