@@ -251,6 +251,32 @@ def add_road_models(segments: list, fields: list) -> list:
     return segments
 
 
+def road_params(params, segments: list) -> np.ndarray:
+    """The fit's (K, 4) ``params`` with the road model of each segment: (K, 6), columns
+    (Gq_n0, w, nmin, nmax, w2, n_break) for :func:`inverse.truck.road_from_params`.
+
+    A segment reported ``two_slope`` gets its two-slope refit (Gq_n0 of the low-frequency
+    line, w_low, nmin, nmax, w_high, n_break), so the road handed on (road.npz, the
+    realisation selection, Table 2, Figure 11, the chassis study) is the road the report
+    describes; a one-slope segment keeps the fit's row with NaN in the last two columns.
+    Without any two-slope segment the (K, 4) ``params`` are returned unchanged.
+    """
+    P = np.atleast_2d(np.asarray(params, dtype=float))
+    if len(segments) != P.shape[0]:
+        raise EroadInputError("road model: one entry per segment expected")
+    if not any(s.get("road_model") == "two_slope" for s in segments):
+        return P[:, :4].copy()
+    out = np.full((P.shape[0], 6), np.nan)
+    out[:, :4] = P[:, :4]
+    for k, s in enumerate(segments):
+        if s.get("road_model") != "two_slope":
+            continue
+        two = s["road_model_fit"]["two_slope"]
+        out[k, 0], out[k, 1] = two["Gq_n0_low_line"], s["w_low"]
+        out[k, 4], out[k, 5] = s["w_high"], s["n_break"]
+    return out
+
+
 def note_line(segments: list) -> str:
     """The line under Table 1 on the road model of each segment."""
     parts = []

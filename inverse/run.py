@@ -255,21 +255,23 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             figures = pool.submit(write_figures, tmp / "figures", **fig_kw) if pool is not None else None
             return sel, fig_kw, figures
 
+        # the road model of each segment, one ISO slope or two (inverse.road_model), first:
+        # the road the selection realises and road.npz holds is the one the report describes
+        t = _time.perf_counter()
+        segs = inv.segments()
+        from inverse.road_model import add_road_models, road_params, select_road_models
+        add_road_models(segs, select_road_models(inv, sim, speed, road_model))
+        params = road_params(params, segs)
+        timing["road_model_s"] = _time.perf_counter() - t
         sel_thread = None
         try:
             # With a pool, the selection (and then the figures) run from a thread of this process
             # on the pool's workers, while this process computes what needs the fit only: the
-            # road model and the lateral-structure sensitivity.
+            # lateral-structure sensitivity.
             if pool is not None:
                 from concurrent.futures import ThreadPoolExecutor
                 sel_thread = ThreadPoolExecutor(1)
                 sel_job = sel_thread.submit(select_and_draw)
-            t = _time.perf_counter()
-            segs = inv.segments()
-            # the road model of each segment, one ISO slope or two (inverse.road_model)
-            from inverse.road_model import add_road_models, select_road_models
-            add_road_models(segs, select_road_models(inv, sim, speed, road_model))
-            timing["road_model_s"] = _time.perf_counter() - t
             from inverse.lateral import note_line, run_summary
 
             t = _time.perf_counter()

@@ -152,7 +152,8 @@ class TruckSimulator:
 
     # ------------------------------------------------------------------ road
     def road(self, params, seed):
-        """The segmented road surface of ``params`` (K, 4) and ``seed``.
+        """The segmented road surface of ``params`` (K, 4) or (K, 6) (:func:`road_from_params`)
+        and ``seed``.
 
         ``seed`` is an int (one realisation) or a pair ``(seed_left, seed_right)``:
         the left half of the road (y > 0) from the first, the right half from the
@@ -248,9 +249,11 @@ def road_from_params(params, seg_lengths, *, seed: int, width: float = SIM_WIDTH
 
     Parameters
     ----------
-    params : (K, 4) array
+    params : (K, 4) or (K, 6) array
         (Gq_n0 [m^3], w [-], nmin, nmax [cycles/m]) per segment; nmax is capped
-        at the grid's 1 / (2 dx).
+        at the grid's 1 / (2 dx).  Six columns add (w2 [-], n_break [cycles/m]) of a
+        two-slope segment (``roadlib.psd.two_slope_psd``; Gq_n0 is then the level of
+        the low-frequency line), NaN in both for one slope.
     seg_lengths : (K,) array
         Road length of each segment [m].
     seed : int
@@ -269,12 +272,19 @@ def road_from_params(params, seg_lengths, *, seed: int, width: float = SIM_WIDTH
 
     P = np.atleast_2d(np.asarray(params, dtype=float))
     L = np.asarray(seg_lengths, dtype=float)
-    if P.shape != (L.size, 4):
-        raise EroadInputError(f"road_from_params: params of shape {P.shape} for {L.size} segments")
+    if P.ndim != 2 or P.shape[0] != L.size or P.shape[1] not in (4, 6):
+        raise EroadInputError(f"road_from_params: params of shape {P.shape} for {L.size} segments "
+                              "(4 or 6 columns expected)")
     nyq = 1.0 / (2.0 * dx)
     total = float(np.sum(L))
+
+    def two(p):
+        if p.size < 6 or not (np.isfinite(p[4]) and np.isfinite(p[5])):
+            return {}
+        return {"w2": float(p[4]), "n_break": float(p[5])}
+
     segs = [RoadSegment(Gq_n0=float(p[0]), share=float(l), w=float(p[1]), nmin=float(p[2]),
-                        nmax=float(min(p[3], nyq)), lam=lam, label=str(labels[i]) if labels else "")
+                        nmax=float(min(p[3], nyq)), lam=lam, label=str(labels[i]) if labels else "", **two(p))
             for i, (p, l) in enumerate(zip(P, L))]
     return segmented_surface(segs, total, width, dx, dy, seed=int(seed))
 

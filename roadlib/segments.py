@@ -86,6 +86,11 @@ class RoadSegment:
         Anisotropy factor [-] (eq (5)).
     label : str
         Free name (e.g. the ISO class letter).
+    w2, n_break : float, optional
+        A two-slope spectrum (``roadlib.psd.two_slope_psd``): waviness ``w2`` [-] above
+        the break frequency ``n_break`` [cycles/m], ``w`` below, ``Gq_n0`` the level of
+        the low-frequency line at n0.  Both or neither; None is one ISO slope (and
+        :meth:`to_dict` then has no such keys, as before the option existed).
     """
 
     Gq_n0: float
@@ -95,6 +100,8 @@ class RoadSegment:
     nmax: float = ISO_BAND[1]
     lam: float = 1.0
     label: str = ""
+    w2: float | None = None
+    n_break: float | None = None
 
     def __post_init__(self):
         try:
@@ -115,13 +122,16 @@ class RoadSegment:
         """The segment's :class:`SpectralParams` on a grid dx, dy [m] (validates)."""
         try:
             return SpectralParams(Gq_n0=self.Gq_n0, w=self.w, nmin=self.nmin, nmax=self.nmax,
-                                  dx=dx, dy=dy, lam=self.lam)
+                                  dx=dx, dy=dy, lam=self.lam, w2=self.w2, n_break=self.n_break)
         except EroadInputError as exc:
             raise EroadInputError(f"segment {self.label or ''}: {exc}".replace("segment : ", "segment: ")) from None
 
     def to_dict(self) -> dict:
-        return {"Gq_n0": self.Gq_n0, "share": self.share, "w": self.w, "nmin": self.nmin,
-                "nmax": self.nmax, "lam": self.lam, "label": self.label}
+        d = {"Gq_n0": self.Gq_n0, "share": self.share, "w": self.w, "nmin": self.nmin,
+             "nmax": self.nmax, "lam": self.lam, "label": self.label}
+        if self.w2 is not None or self.n_break is not None:
+            d.update(w2=self.w2, n_break=self.n_break)
+        return d
 
 
 def _solve_lateral(y: np.ndarray, target: np.ndarray, sy: float) -> np.ndarray:

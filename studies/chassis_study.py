@@ -202,7 +202,7 @@ def _equivalent_segments(road) -> tuple[list[dict], str]:
     meta = road.meta or {}
     gen = meta.get("generator", "")
     nyq = 0.5 / road.dx
-    keys = ("Gq_n0", "w", "nmin", "nmax", "lam", "label")
+    keys = ("Gq_n0", "w", "nmin", "nmax", "lam", "label", "w2", "n_break")
     if gen == "roadlib.segments.segmented_surface" and meta.get("segments"):
         segs = []
         for s in meta["segments"]:

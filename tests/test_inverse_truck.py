@@ -5,6 +5,7 @@ import pickle
 import numpy as np
 import pytest
 
+from eroad.errors import EroadInputError
 from inverse.sensitivity import check_common_random_numbers
 from inverse.truck import TruckPredictRms, TruckSimulator, nmax_cap, road_from_params
 from roadlib.synthesis import SpectralParams, harmonic_field
@@ -94,6 +95,37 @@ def test_road_from_params_and_nmax_cap():
     assert nmax_cap() == pytest.approx(10.0)
     big = road_from_params(np.array([[64e-6, 2.0, 0.05, 30.0]]), [50.0], seed=2, width=3.0)
     assert big.meta["segments"][0]["nmax"] == pytest.approx(20.0)
+
+
+def test_road_from_params_two_slope_columns():
+    """Six columns: NaN in (w2, n_break) is the four-column road bit for bit; a two-slope
+    row gives a segment whose track follows the two slopes.  The Whittle two-slope fit of
+    the Welch PSD of a 3 km single track (1024-point segments: about 230 averages, each
+    bin's log scatter about 0.07) recovers the exponents within 0.15 and the break within
+    a factor 1.3 -- the tolerances of tests/test_road_model.py's synthesis check, which
+    has fewer averages; the segment's meta carries w2 and n_break so the chassis study's
+    equivalent realisations keep them."""
+    from scipy.signal import welch
+
+    from inverse.road_model import fit_two_slope_psd
+    from studies.chassis_study import _equivalent_segments
+
+    P6 = np.column_stack([P2, np.full((2, 2), np.nan)])
+    a = road_from_params(P2, [40.0, 60.0], seed=2, width=3.0)
+    b = road_from_params(P6, [40.0, 60.0], seed=2, width=3.0)
+    assert np.array_equal(a.z, b.z) and "w2" not in b.meta["segments"][0]
+    two = np.array([[256e-6, 3.0, 0.02, 4.0, 1.7, 0.25]])
+    road = road_from_params(two, [3000.0], seed=5, width=0.0, dx=0.1)
+    n, g = welch(road.z[:, 0], fs=10.0, nperseg=1024)
+    r = fit_two_slope_psd(n, g, (0.04, 3.0))
+    assert abs(r["w_low"] - 3.0) < 0.15 and abs(r["w_high"] - 1.7) < 0.15
+    assert abs(np.log(r["n_break"] / 0.25)) < np.log(1.3)
+    seg = road.meta["segments"][0]
+    assert (seg["w2"], seg["n_break"]) == (1.7, 0.25)
+    eq, _ = _equivalent_segments(road)
+    assert (eq[0]["w2"], eq[0]["n_break"]) == (1.7, 0.25)
+    with pytest.raises(EroadInputError, match="4 or 6 columns"):
+        road_from_params(P2[:, :3], [40.0, 60.0], seed=2)
 
 
 def test_predict_rms_scales_with_sqrt_gq():

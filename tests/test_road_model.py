@@ -122,6 +122,25 @@ def test_fields_notes_and_no_overwrite():
         add_road_models([{"w": 2.0}], [{"w": 3.0}])
 
 
+def test_road_params_hand_on_the_two_slope_refit():
+    """The road handed on (road.npz, the selection): a two-slope segment's row is its
+    two-slope refit (low-line level, w_low, the fit's band, w_high, n_break), a one-slope
+    row the fit's with NaN; no two-slope segment leaves the (K, 4) fit unchanged."""
+    from inverse.road_model import road_params
+
+    P = np.array([[64e-6, 2.0, 0.05, 4.0], [256e-6, 2.4, 0.03, 3.0]])
+    one = [one_slope_fields(2.0), one_slope_fields(2.4)]
+    assert np.array_equal(road_params(P, one), P)
+    two = {"road_model": "two_slope", "w_low": 3.1, "w_high": 1.9, "n_break": 0.25, "ic_delta": 4.2,
+           "road_model_fit": {"two_slope": {"Gq_n0_low_line": 300e-6}}}
+    R = road_params(P, [one[0], two])
+    assert R.shape == (2, 6)
+    assert np.array_equal(R[0, :4], P[0]) and np.isnan(R[0, 4:]).all()
+    assert list(R[1]) == [300e-6, 3.1, 0.03, 3.0, 1.9, 0.25]
+    with pytest.raises(Exception, match="one entry per segment"):
+        road_params(P, one[:1])
+
+
 def test_fit_two_slope_psd_recovers_a_synthesised_profile():
     """The Whittle two-slope fit on the Welch PSD of a synthesised 4 km two-slope profile:
     exponents within 0.15 and the break within a factor 1.3 (Welch with 1024-point
@@ -158,3 +177,8 @@ def test_invert_reports_the_road_model_beside_the_old_fields(tmp_path):
         assert sb["road_model"] == "one_slope" and sb["ic_delta"] is None
     md = (tmp_path / "a" / "tables" / "table1.md").read_text()
     assert "road_model" in md and "bic_gain_two_slope" in md
+    from roadlib.surface import RoadSurface
+    for run in (a, b):
+        road = RoadSurface.load(tmp_path / ("a" if run is a else "b") / "road.npz")
+        for s, m in zip(run["segments"], road.meta["segments"]):
+            assert m.get("w2") == (s["w_high"] if s["road_model"] == "two_slope" else None)
