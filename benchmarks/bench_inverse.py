@@ -306,6 +306,8 @@ def main(argv=None) -> int:
                     help="where the synthetic datasets are made or found (default: ROOT); share "
                          "it between runs that compare settings on the same drives")
     ap.add_argument("--no-polish", action="store_true", help="switch off the fit's polishing step")
+    ap.add_argument("--fit", default="simulation", choices=["simulation", "linear"],
+                    help="the fit's model, as `eroad invert --fit` (each record's fit_model field says which ran)")
     ap.add_argument("--known-noise", action="store_true",
                     help="give the inversion the sensor-noise levels (a data-sheet value a user "
                          "would know; read from truth/ noise, nothing else of the truth)")
@@ -376,7 +378,7 @@ def main(argv=None) -> int:
                                                 ("body_acc", "body_acc_mps2"))}
         t0 = time.perf_counter()
         inv = dict(workers=a.workers, seed=0, candidates=0, max_iter=a.max_iter, channels=a.channels,
-                   force=True, polish=not a.no_polish, noise_sd=noise)
+                   force=True, polish=not a.no_polish, noise_sd=noise, fit_model=a.fit)
         if a.effects_auto:
             from diagnosis.closed_loop import invert_closed_loop
             summ = invert_closed_loop(blind, root / f"run-{seed}", progress=lambda _m: None, **inv)

@@ -1,18 +1,11 @@
-"""``benchmarks/bench_inverse.py`` with the linear-model fit (``eroad invert --fit linear``).
-
-bench_inverse.py inverts every blind drive with ``inverse.cli.run_inversion`` at its
-defaults (``--fit simulation``) and has no option for the fit model; this wrapper runs
-its ``main`` unchanged with that function's ``fit_model`` set to "linear" (each record's
-``fit_model`` field, read from the run's summary.json, says which fit ran), so the
-blind set and ``benchmarks/calibrate_uncertainty.py`` can score the linear fit's
-accuracy and interval coverage on the same drives (``--data-root``).
+"""``benchmarks/bench_inverse.py --fit linear`` (``eroad invert --fit linear``), under the
+name the linear-fit result folders were made with.
 
 Run:  nice python benchmarks/bench_inverse_linear.py --scenario null --cases 10 --root R1 --data-root D
       (every option is bench_inverse.py's)
 """
 from __future__ import annotations
 
-import functools
 import sys
 from pathlib import Path
 
@@ -21,10 +14,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 def main(argv=None) -> int:
     import bench_inverse
-    import inverse.cli
 
-    inverse.cli.run_inversion = functools.partial(inverse.cli.run_inversion, fit_model="linear")
-    return bench_inverse.main(argv)
+    return bench_inverse.main(["--fit", "linear"] + list(sys.argv[1:] if argv is None else argv))
 
 
 if __name__ == "__main__":
