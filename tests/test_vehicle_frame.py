@@ -110,3 +110,16 @@ def test_tune_frame_converges_from_detuned_start(vehicle, gj, ei):
     assert replace(tuned.frame, torsion_stiffness=0.0, bending_stiffness=0.0) == \
         replace(vp.frame, torsion_stiffness=0.0, bending_stiffness=0.0)
     assert tuned.axles == vp.axles and tuned.sprung == vp.sprung
+
+
+def test_tune_frame_refuses_an_unreachable_target():
+    """A torsion target the factor-30 search range cannot reach (the shipped frame's mode
+    x 20: the frequency grows about as sqrt(GJ), so at most x 5.5 is reachable, less as
+    the mode couples) ends on the range edge: one clear error naming the mode, not a
+    silently detuned frame."""
+    from eroad.errors import EroadInputError
+
+    vp = load_vehicle("dump_truck_8x4")
+    far = replace(vp, frame=replace(vp.frame, target_torsion_hz=20 * vp.frame.target_torsion_hz))
+    with pytest.raises(EroadInputError, match="torsion target .* not reached"):
+        tune_frame(far)

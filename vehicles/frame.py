@@ -24,6 +24,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from eroad.errors import EroadInputError
 from vehicles.params import Frame, MassItem, VehicleParams
 
 
@@ -292,6 +293,13 @@ def tune_frame(vp: VehicleParams, n_segments: int | None = None, iterations: int
     -------
     VehicleParams
         With tuned ``frame.torsion_stiffness`` and ``frame.bending_stiffness``.
+
+    Raises
+    ------
+    EroadInputError
+        A target the search range cannot reach (the bisection ends on a range edge with
+        the mode more than ``REACH_TOL`` off): the line names the mode, the target, the
+        frequency reached and the stiffness.
     """
     fr = vp.frame
     bounds = {"torsion": [np.log(fr.torsion_stiffness / 30), np.log(fr.torsion_stiffness * 30)],
@@ -313,4 +321,18 @@ def tune_frame(vp: VehicleParams, n_segments: int | None = None, iterations: int
                 done = False
         if done:
             break
+    got = frame_mode_frequencies(vp, n_segments)
+    for kind in ("torsion", "bending"):
+        f = got[f"{kind}_hz"]
+        if not (np.isfinite(f) and abs(f / target[kind] - 1) < REACH_TOL):
+            stiff = getattr(vp.frame, field_of[kind])
+            raise EroadInputError(
+                f"frame tuning: the {kind} target {target[kind]:g} Hz is not reached within a factor 30 of "
+                f"the start {field_of[kind]} (got {f:.3g} Hz at {stiff:.3g}); change the target or the start value")
     return vp
+
+
+#: relative frequency error above which tune_frame reports the target as not reached
+#: (10x its default stopping tolerance: the bisection's own stop is 0.2 %, a mode-classification
+#: jump can leave it at about that; an unreachable target ends tens of per cent off)
+REACH_TOL = 0.02
