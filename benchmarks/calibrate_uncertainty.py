@@ -178,7 +178,16 @@ def main(argv=None) -> int:
             pr = load(root, a.min_s, profile=True)
             if pr:
                 extra[f"{name}/profile"] = pr
-    const = {"R_REF": U.R_REF, "R_GATE": U.R_GATE, "KAPPA": dict(U.KAPPA), "BETA": dict(U.BETA)}
+    # the constants of the fit that made the records (each record's fit_model; older records
+    # without it came from the simulation fit)
+    roots = [Path(i.partition("=")[2]) for i in a.sets]
+    models = {json.loads(li).get("fit_model") or "simulation"
+              for r in roots for li in (r / "results.jsonl").read_text().splitlines() if li.strip()}
+    if len(models) != 1 and not a.calibrate:
+        ap.error(f"the sets come from different fit models ({', '.join(sorted(models))}); score them apart")
+    fit_model = models.pop() if len(models) == 1 else "mixed"
+    const = {k: (dict(v) if isinstance(v, dict) else v)
+             for k, v in U.calibration(fit_model if fit_model != "mixed" else "simulation").items()}
     if a.calibrate:
         const = calibrate(sets[a.calibrate])
         print(f"calibrated on '{a.calibrate}' ({len(sets[a.calibrate])} segments >= {a.min_s:g} s): "
@@ -189,7 +198,7 @@ def main(argv=None) -> int:
             const["BETA"] = choose_beta(sets[a.beta_from], const)
             print(f"BETA chosen on '{a.beta_from}': " + ", ".join(f"{k} {v:g}" for k, v in const["BETA"].items()))
     else:
-        print(f"constants of inverse/uncertainty.py: R_REF {const['R_REF']}, R_GATE {const['R_GATE']}, "
+        print(f"constants of inverse/uncertainty.py for the {fit_model} fit: R_REF {const['R_REF']}, R_GATE {const['R_GATE']}, "
               f"KAPPA {const['KAPPA']}, BETA {const['BETA']}")
     print("\n| set | segments >= %g s | flagged poor | 90 %% cover ln Gq(n0) | w | ln G(n_best) | "
           "noise-only sd: ln Gq(n0) | w | ln G(n_best) |" % a.min_s)

@@ -159,7 +159,8 @@ class Inversion:
         prop = self.segmentation.proportions
         for k, s in enumerate(self.fit.segments):
             d = s.as_dict()
-            sd = honest_sd(d["sd"], d.get("sd_ln_G_n_best"), d["objective"], d["n_features"])
+            fm = self.config.fit_model
+            sd = honest_sd(d["sd"], d.get("sd_ln_G_n_best"), d["objective"], d["n_features"], fit_model=fm)
             iv = {"Gq_n0": interval90(d["Gq_n0"], sd["ln_Gq_n0"], log=True),
                   "w": interval90(d["w"], sd["w"], log=False)}
             best = {}
@@ -174,7 +175,7 @@ class Inversion:
                          "identifiable": d["identifiable"],
                          "sd": {key: v for key, v in sd.items() if key != "ln_G_n_best"},
                          "sd_laplace": d["sd"], "sd_ln_Gq_n0": sd["ln_Gq_n0"], "interval90": iv,
-                         "fit_quality": fit_quality(d["objective"], d["n_features"]),
+                         "fit_quality": fit_quality(d["objective"], d["n_features"], fit_model=fm),
                          "objective": d["objective"], "n_features": d["n_features"], "converged": d["converged"],
                          "at_bound": at_bounds(d["Gq_n0"], d["w"], self.config.bounds),
                          **{key: d[key] for key in ("sd_robust", "consistency") if key in d},

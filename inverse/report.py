@@ -82,9 +82,10 @@ def table1_note(fit_quality: dict | None = None, road_model: bool = True, segmen
     mean (:data:`ROAD_MODEL_NOTE`)."""
     from inverse.uncertainty import R_GATE
 
+    gate = next((r["fit_quality"]["gate"] for r in segments or [] if "gate" in r.get("fit_quality", {})), R_GATE)
     note = ("The 90 % intervals and sd columns hold noise, realisation and model-form error, "
             "calibrated on blind drives (docs/inverse.md, section 11). 'fit' is the fit-quality gate: "
-            f"'poor' where the misfit per feature exceeds {R_GATE:g}, i.e. the model does not explain "
+            f"'poor' where the misfit per feature exceeds {gate:g}, i.e. the model does not explain "
             "the segment's data and its numbers are not a clean result.")
     if fit_quality and fit_quality.get("status") == "poor":
         note = f"**POOR FIT**: {fit_quality['message']}.\n\n" + note

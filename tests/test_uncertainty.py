@@ -72,3 +72,21 @@ def test_table1_shows_intervals_and_gate():
     row = table1([seg]).iloc[0]
     assert row["Gq_n0_90pct_1e-6m3"] == "200-330" and row["w_90pct"] == "1.80-2.20"
     assert row["fit"] == "clean" and row["misfit_per_feature"] == 0.5
+
+
+def test_each_fit_model_has_its_own_calibration():
+    """The linear fit's constants (calibrated apart, inverse/uncertainty.py CALIBRATIONS)
+    apply when it ran: its gate and its KAPPA; the simulation fit keeps the module
+    constants; an unknown fit model is refused rather than given another's intervals."""
+    lin = U.calibration("linear")
+    assert U.calibration("simulation")["R_GATE"] == U.R_GATE
+    r = 0.5 * (lin["R_GATE"] + U.R_GATE)        # between the two gates: poor only for the linear fit
+    assert U.fit_quality(r * 50, 50, fit_model="linear")["status"] == "poor"
+    assert U.fit_quality(r * 50, 50)["status"] == "clean"
+    assert U.fit_quality(r * 50, 50, fit_model="linear")["gate"] == lin["R_GATE"]
+    sd = U.honest_sd({"ln_Gq_n0": 0.1, "w": 0.05}, 0.04, objective=0.5 * lin["R_REF"] * 10, n_features=10,
+                     fit_model="linear")
+    assert sd["w"] == pytest.approx(lin["KAPPA"]["w"] * 0.05)
+    assert sd["ln_G_n_best"] == pytest.approx(lin["KAPPA"]["ln_G_n_best"] * 0.04)
+    with pytest.raises(ValueError, match="no uncertainty calibration"):
+        U.calibration("quarter")
