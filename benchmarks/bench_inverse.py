@@ -327,7 +327,13 @@ def main(argv=None) -> int:
                     help="invert as `eroad invert --effects auto` does: diagnose each drive first and "
                          "invert with the effect a clear verdict names (the loop closed); the nominal "
                          "inversion of the same drive is scored beside it (`nominal` rows)")
+    ap.add_argument("--diagnoses", default=None, metavar="ROOT",
+                    help="with --effects-auto: use the diagnoses of an earlier --effects-auto root "
+                         "(ROOT/run-SEED/diagnose) instead of diagnosing each drive again; the diagnosis "
+                         "does not depend on the inversion's options (e.g. --fit)")
     a = ap.parse_args(argv)
+    if a.diagnoses and not a.effects_auto:
+        ap.error("--diagnoses needs --effects-auto")
     if a.measured_every and a.scenario != "second":
         ap.error("--measured-every needs --scenario second")
     if a.measured_every < 0:
@@ -381,7 +387,10 @@ def main(argv=None) -> int:
                    force=True, polish=not a.no_polish, noise_sd=noise, fit_model=a.fit)
         if a.effects_auto:
             from diagnosis.closed_loop import invert_closed_loop
-            summ = invert_closed_loop(blind, root / f"run-{seed}", progress=lambda _m: None, **inv)
+            dg = Path(a.diagnoses) / f"run-{seed}" / "diagnose" if a.diagnoses else None
+            if dg is not None and not (dg / "summary.json").is_file():
+                raise SystemExit(f"--diagnoses: no diagnosis of seed {seed} at {dg}")
+            summ = invert_closed_loop(blind, root / f"run-{seed}", progress=lambda _m: None, diagnosis=dg, **inv)
         else:
             summ = run_inversion(blind, root / f"run-{seed}", **inv)
         wall = time.perf_counter() - t0
