@@ -306,7 +306,7 @@ def main(argv=None) -> int:
                     help="where the synthetic datasets are made or found (default: ROOT); share "
                          "it between runs that compare settings on the same drives")
     ap.add_argument("--no-polish", action="store_true", help="switch off the fit's polishing step")
-    ap.add_argument("--fit", default="simulation", choices=["simulation", "linear"],
+    ap.add_argument("--fit", default="linear", choices=["linear", "simulation"],
                     help="the fit's model, as `eroad invert --fit` (each record's fit_model field says which ran)")
     ap.add_argument("--known-noise", action="store_true",
                     help="give the inversion the sensor-noise levels (a data-sheet value a user "

@@ -59,9 +59,10 @@ def register(subparsers) -> None:
                    help="known white sensor noise, standard deviation in the channel's SI unit, for a "
                         "channel (susp_disp_3L=1e-4) or a quantity (axle_acc=0.03); repeatable; channels "
                         "not given are estimated from the top of their spectrum")
-    p.add_argument("--fit", choices=("simulation", "linear"), default="simulation",
-                   help="fit model: 'simulation' (every evaluation a time simulation; default) or 'linear' "
-                        "(linear-model features corrected by a few time simulations, docs/inverse.md section 12)")
+    p.add_argument("--fit", choices=("linear", "simulation"), default="linear",
+                   help="fit model: 'linear' (linear-model features corrected by a few time simulations; "
+                        "default) or 'simulation' (every evaluation a time simulation, about 3x slower); "
+                        "docs/inverse.md section 12")
     p.add_argument("--selection", choices=("linear", "simulation"), default="linear",
                    help="how the candidate road realisations are scored: 'linear' (the linear truck's time "
                         "response corrected by the simulated ones; the fit's and the best candidates "
