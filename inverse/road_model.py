@@ -46,7 +46,11 @@ used (``--fit linear``; a simulation fit has none and the linear model is used a
        ic_delta = (chi2_one - chi2_two) / c - 2 ln(n_eff)
 
    and the segment is reported ``two_slope`` when ic_delta > 0 (the two-slope BIC is
-   lower).  Penalty: 2 ln(n_eff) = 6.8 at n_eff = 30 (a 15 s segment with four axle-3
+   lower) and neither slope sits on a bound of w (``ParamBounds.w``, the published
+   range of real roads): a pinned slope is the bound's, not the road's, so the two
+   slopes then describe a misfit (a vehicle gap, a band edge) rather than the road, and
+   the segment keeps one slope with ``road_model_note`` saying so (the refit is kept in
+   ``road_model_fit``, with ``rejected_at_bound``).  Penalty: 2 ln(n_eff) = 6.8 at n_eff = 30 (a 15 s segment with four axle-3
    channels), 4.2 at n_eff = 8.
 
    Why BIC and not AIC: the choice is between a simple model that is usually right
@@ -74,6 +78,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from eroad.errors import EroadInputError
+from inverse.pipeline import AT_BOUND_TOL
 from inverse.spectral import N0, ParamBounds
 
 #: starting break frequencies per segment, log-even inside the band (3: on 40 one-slope and 10
@@ -188,10 +193,20 @@ def select_segment(linear, features, k: int, row, bounds: ParamBounds | None = N
            "one_slope": {"Gq_n0": math.exp(x1[0]), "w": float(x1[1])},
            "two_slope": {"Gq_n0_low_line": gq2, "Gd_n0": float(two_slope_psd([N0], gq2, wl, wh, nb)[0]),
                          "w_low": wl, "w_high": wh, "n_break": nb}}
-    if delta > 0:
+    pinned = [f"{name} = {v:.3g}" for name, v in (("w_low", wl), ("w_high", wh))
+              if v <= bounds.w[0] + AT_BOUND_TOL["w"] or v >= bounds.w[1] - AT_BOUND_TOL["w"]]
+    if delta > 0 and not pinned:
         return {"road_model": "two_slope", "w_low": wl, "w_high": wh, "n_break": nb, "ic_delta": delta,
                 "road_model_fit": fit}
-    out = one_slope_fields(w)
+    note = None
+    if delta > 0:
+        # a slope on the waviness bound is the bound's, not the road's: the two slopes then
+        # describe a misfit the published range of real roads does not hold (a vehicle gap,
+        # a band edge), and the road handed on keeps the one-slope fit
+        note = (f"two slopes rejected although BIC prefers them: {', '.join(pinned)} on a bound of "
+                f"w ({bounds.w[0]:g}-{bounds.w[1]:g})")
+        fit["rejected_at_bound"] = pinned
+    out = one_slope_fields(w, note=note)
     out.update(ic_delta=delta, road_model_fit=fit)
     return out
 
