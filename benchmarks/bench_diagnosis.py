@@ -78,6 +78,9 @@ def main(argv=None) -> int:
     ap.add_argument("--share-min", type=float, default=None)
     ap.add_argument("--signature-max", type=float, default=None)
     ap.add_argument("--signature-share", type=float, default=None)
+    ap.add_argument("--signature-method", choices=("single_input", "two_input"), default=None,
+                    help="with --rescore: the transmissibility the verdict checks (default: "
+                         "diagnosis.verdict.SIGNATURE_METHOD)")
     args = ap.parse_args(argv)
 
     if args.sweep:
@@ -100,7 +103,8 @@ def main(argv=None) -> int:
         from diagnosis.blind import format_confusion, rescore
 
         th = {k: v for k, v in (("share_min", args.share_min), ("signature_max", args.signature_max),
-                                ("signature_share", args.signature_share)) if v is not None}
+                                ("signature_share", args.signature_share),
+                                ("signature_method", args.signature_method)) if v is not None}
         out = rescore(args.out, **th)
         print(f"thresholds {th or 'defaults'}")
         print(format_confusion(out["score"]))
