@@ -336,10 +336,20 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
         conf = "ambiguous"
         reason += (f"; calibrated at the edge of its search range ({', '.join(edges)}): the "
                    f"value is a bound, not an estimate")
+    if not gap_present:
+        # the paired comparison can see an effect the whole gap's road-phase scatter hides,
+        # but then the share above is a ratio over a difference within noise (it can read
+        # far over 100 %): a name that rests on the paired test alone is never 'clear'
+        conf = "ambiguous"
+        reason += (f"; the nominal model's own held-out gap ({nom.get('heldout_gap', float('nan')):.3g}) "
+                   f"is within a correct model's scatter ({nom.get('null_gap_mean', float('nan')):.3g} +- "
+                   f"{nom.get('null_gap_std', float('nan')):.2g}): the name rests on the paired "
+                   f"comparison alone, and the share is not a measure here")
     # identified: the effect is named and neither a rival nor a range edge puts its identity
-    # or value in doubt (a remainder beyond it does not): what a correction may use
+    # or value in doubt (a remainder beyond it does not), and there is a gap beyond noise to
+    # correct: what a correction may use
     return dict(out, verdict=rv, confidence=conf, reason=reason,
-                identified=bool(rd.get("confidence") == "clear" and not edges))
+                identified=bool(rd.get("confidence") == "clear" and not edges and gap_present))
 
 
 def search_ranges(candidates: Sequence) -> dict:

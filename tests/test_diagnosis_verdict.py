@@ -118,3 +118,13 @@ def test_identified_effect_with_a_remainder_drives_the_correction():
     d = decide(s)
     s.update(verdict=d["verdict"], verdict_confidence=d["confidence"], verdict_detail=d)
     assert d["identified"] is False and effects_from_diagnosis(s)[0] is None
+
+
+def test_a_name_without_a_gap_beyond_noise_is_never_clear():
+    """An accepted effect (paired test) on a drive whose nominal gap is within a correct
+    model's scatter: named at most 'ambiguous', and the reason says the share (here a ratio
+    over a 0.01 difference: 300 %) is no measure (second-family blind case 6)."""
+    d = decide(_summary(before=0.41, after=0.38, null_mean=0.40, null_sd=0.05, gap_present=False))
+    assert d["verdict"] == "leaf_friction" and d["confidence"] == "ambiguous"
+    assert d["explained_share"] == pytest.approx(3.0)
+    assert "within a correct model's scatter" in d["reason"] and not d["identified"]
