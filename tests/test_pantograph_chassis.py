@@ -1,8 +1,11 @@
 """Chassis-stiffness study in contact-force terms (studies.pantograph_chassis).
 
-A tiny study (frame factors 1 and rigid, nominal mounts, a 4 s drive at 80 km/h on
-the identified road of the committed reference run, serial) checks the table's columns,
-the run folder and these physical properties, each of which can fail:
+A tiny study (frame factors 1 and rigid, nominal mounts, a 4 s drive at 80 km/h on a
+class C road made by roadlib in the test, seed 2, serial) checks the table's columns, the
+run folder and these physical properties, each of which can fail.  (Until 2026-11-24 it
+drove the committed reference run's identified road; remade, that road starts with a
+class A stretch whose base motion, 2 mm/s in 0.5-5 Hz, is too small for the checks below to
+mean anything: a test should not hang on a result file that is regenerated.)
 
 * the base excitation adds to the contact-force sd: sd(drive) > sd(base still), and the
   base-induced part ``F(drive) - F(base still)`` is not zero (it is zero for the still
@@ -12,9 +15,11 @@ the run folder and these physical properties, each of which can fail:
   base-induced force (tolerance 1e-6 relative: round-off of ~3000 HHT steps, each a
   banded solve, is ~1e-12; 1e-6 also leaves room for the float64 sums);
 * below the pantograph's modes the base acts through the lower damper c3 (70 N s/m): the
-  base-induced force per unit base velocity in 0.5-5 Hz lies between 0.5 c3 and 1.0 c3
-  (the lower frame moves a little with the base, so less than c3; far more than the
-  base spring k3 = 0.1 N/m could give).
+  base-induced force per unit base velocity in 0.5-5 Hz lies between 0.5 c3 and 1.5 c3.
+  Far more than the base spring k3 = 0.1 N/m could give, far less than a rigid coupling of
+  the 22 kg pantograph (m omega = 280-690 N s/m at 2-5 Hz); above c3 by the inertia of the
+  part of the frame that moves with the base (|c3 + i omega m_eff|: 79 N s/m measured here,
+  m_eff of about 3 kg at 2 Hz; the bound allows up to about 4 kg at 3 Hz).
 """
 import json
 import math
@@ -28,23 +33,20 @@ from eroad.cli import main
 from studies.pantograph_chassis import (FORCE_BANDS, TABLE_COLUMNS, band_rms, contact_case,
                                         run_pantograph_chassis, study_cases)
 
-ROAD = Path(__file__).resolve().parents[1] / "results" / "reproduce" / \
-    "20261124-luliang-seed0" / "invert" / "road.npz"
-
-
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
-    if not ROAD.is_file():
-        pytest.skip("reference road not in this checkout")
     out = tmp_path_factory.mktemp("pc")
-    s = run_pantograph_chassis(ROAD, out, run_dir=out / "run", frames=(1.0, "rigid"),
+    road = out / "road.npz"
+    assert main(["road", "generate", "--class", "C", "--length", "150", "--width", "4", "--seed", "2",
+                 "--out", str(road)]) == 0
+    s = run_pantograph_chassis(road, out, run_dir=out / "run", frames=(1.0, "rigid"),
                                mounts=(1.0,), duration=4.0, n_workers=0,
                                cache_dir=out / "cache", progress=False, command=["test"])
-    return s, pd.read_csv(out / "run" / "data" / "table.csv", dtype={"frame": str}), out
+    return s, pd.read_csv(out / "run" / "data" / "table.csv", dtype={"frame": str}), out, road
 
 
 def test_table_columns_and_run_folder(tiny):
-    s, t, _ = tiny
+    s, t, _, _ = tiny
     run = Path(s["path"])
     assert list(t.columns) == list(TABLE_COLUMNS)
     assert list(t["base"]) == ["drive", "drive", "still"]
@@ -60,7 +62,7 @@ def test_table_columns_and_run_folder(tiny):
 
 
 def test_base_excitation_adds_to_the_sd(tiny):
-    _, t, _ = tiny
+    _, t, _, _ = tiny
     still = t[t["base"] == "still"].iloc[0]
     drive = t[t["base"] == "drive"]
     assert still["base_induced_sd_N"] == 0.0
@@ -75,10 +77,10 @@ def test_base_excitation_adds_to_the_sd(tiny):
 
 
 def test_base_acts_through_the_lower_damper(tiny):
-    _, t, _ = tiny
+    _, t, _, _ = tiny
     drive = t[t["base"] == "drive"]
     ratio = drive["dF_rms_0.5-5Hz_N"] / (1e-3 * drive["vz_rms_0.5-5Hz_mm_s"])
-    assert ((ratio > 0.5 * 70.0) & (ratio < 70.0)).all(), ratio.tolist()
+    assert ((ratio > 0.5 * 70.0) & (ratio < 1.5 * 70.0)).all(), ratio.tolist()
 
 
 def test_contact_force_linear_in_base_motion(tiny):
@@ -86,8 +88,8 @@ def test_contact_force_linear_in_base_motion(tiny):
     from studies.pantograph_chassis import code_version
     from studies.sweep import run_cases
 
-    out = tiny[2]
-    spec = road_specs(ROAD, n_seeds=0)[0][0]
+    out, road = tiny[2], tiny[3]
+    spec = road_specs(road, n_seeds=0)[0][0]
     cases = study_cases(spec, frames=(1.0, "rigid"), mounts=(1.0,), duration=4.0)
     # the study's cases (frame 1 with base scale 1, and the still base) from its cache,
     # in float64; only the doubled base motion is computed here
