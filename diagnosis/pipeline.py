@@ -769,7 +769,11 @@ def _band_share_log_ratio(sig: Signals, sim: dict, mask: np.ndarray, names, band
     """``ln(Pm_band / Pm_ref) - ln(Ps_band / Ps_ref)`` pooled over the channels ``names`` on the
     samples ``mask`` (runs of at least ``min_run`` samples), as :func:`_low_band_log_ratio`
     with the bands given."""
-    pooled = _pooled_psd(sig, sim, mask, names, min_run)
+    return _share_log_ratio(_pooled_psd(sig, sim, mask, names, min_run), band, ref)
+
+
+def _share_log_ratio(pooled, band, ref) -> float:
+    """:func:`_band_share_log_ratio` of an already pooled ``(f, Pm, Ps)`` (None: NaN)."""
     if pooled is None:
         return float("nan")
     f, pm, ps = pooled
@@ -781,12 +785,10 @@ def _band_share_log_ratio(sig: Signals, sim: dict, mask: np.ndarray, names, band
     return math.log(vals[0] / vals[1]) - math.log(vals[2] / vals[3])
 
 
-def _band_log_ratio(sig: Signals, sim: dict, mask: np.ndarray, names, band,
-                    min_run: int = 512) -> float:
-    """``ln(Pm_band / Ps_band)``: measured over simulated power in ``band`` [Hz], pooled over
-    the channels ``names`` on the samples ``mask`` (as :func:`_band_share_log_ratio`)."""
-    pooled = _pooled_psd(sig, sim, mask, names, min_run) if band[1] > band[0] else None
-    if pooled is None:
+def _power_log_ratio(pooled, band) -> float:
+    """``ln(Pm_band / Ps_band)``: measured over simulated power in ``band`` [Hz] of a pooled
+    ``(f, Pm, Ps)`` (:func:`_pooled_psd`; None, or an empty band: NaN)."""
+    if pooled is None or not band[1] > band[0]:
         return float("nan")
     f, pm, ps = pooled
     m = (f >= band[0]) & (f < band[1])
@@ -861,14 +863,14 @@ def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | No
         sims = [model.add_noise(model.run({}, 0.0, T, seed + 23 * r, gq=gq), seed + 23 * r + 1)
                 for r in range(NMAX_SEEDS)]
         for k in np.nonzero(todo)[0]:
-            v = [_band_share_log_ratio(sig, sm, masks[k], names, band, NMAX_REF_BAND)
-                 for sm in sims]
+            pooled = [_pooled_psd(sig, sm, masks[k], names) for sm in sims]   # once for both statistics
+            v = [_share_log_ratio(pl, band, NMAX_REF_BAND) for pl in pooled]
             v = [x for x in v if math.isfinite(x)]
             d[g, k] = float(np.mean(v)) if v else float("nan")
             if g < g0:
                 # above the cut the simulation is noise only: is the measurement too?
                 above = (NMAX_ABOVE * NMAX_GRID[g] * vmax[k], band[1])
-                v = [_band_log_ratio(sig, sm, masks[k], names, above) for sm in sims]
+                v = [_power_log_ratio(pl, above) for pl in pooled]
                 v = [x for x in v if math.isfinite(x)]
                 e[g, k] = float(np.mean(v)) if v else float("nan")
 

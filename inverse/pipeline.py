@@ -100,17 +100,26 @@ class InversionConfig:
 AT_BOUND_TOL = {"w": 0.01, "ln_Gq_n0": 0.01}
 
 
+def w_bound_side(w: float, bounds) -> str | None:
+    """'upper' or 'lower' when a waviness sits on that bound of ``bounds.w`` (within
+    ``AT_BOUND_TOL``), else None."""
+    lw, hw = bounds.w
+    if w >= hw - AT_BOUND_TOL["w"]:
+        return "upper"
+    if w <= lw + AT_BOUND_TOL["w"]:
+        return "lower"
+    return None
+
+
 def at_bounds(Gq_n0: float, w: float, bounds) -> list:
     """Which of a segment's fitted level and waviness sit on a bound of the fit, as
     strings such as ``"w = 3.5 (upper bound)"``: the data pushed the parameter out of
     the range the road model allows, so its value (and the level traded against it) is
     the bound's, not the road's."""
     out = []
-    lw, hw = bounds.w
-    if w >= hw - AT_BOUND_TOL["w"]:
-        out.append(f"w = {hw:g} (upper bound)")
-    elif w <= lw + AT_BOUND_TOL["w"]:
-        out.append(f"w = {lw:g} (lower bound)")
+    side = w_bound_side(w, bounds)
+    if side:
+        out.append(f"w = {bounds.w[side == 'upper']:g} ({side} bound)")
     lg = math.log(Gq_n0)
     if lg >= math.log(bounds.Gq_n0[1]) - AT_BOUND_TOL["ln_Gq_n0"]:
         out.append(f"Gq_n0 = {bounds.Gq_n0[1]:g} m^3 (upper bound)")

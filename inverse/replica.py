@@ -754,13 +754,10 @@ def nrmse(pred, meas) -> float:
 def inversion_segment_psd(seg: dict, n) -> np.ndarray:
     """The PSD [m^3] an inversion segment (summary.json row) reports at ``n`` [cycles/m]:
     its two-slope refit where the road model chose two slopes, else the one-slope fit."""
-    from roadlib.psd import iso_psd, two_slope_psd
+    from inverse.road_model import segment_spectrum
+    from roadlib.psd import road_psd
 
-    n = np.asarray(n, float)
-    if seg.get("road_model") == "two_slope":
-        two = (seg.get("road_model_fit") or {}).get("two_slope", {})
-        return two_slope_psd(n, two["Gq_n0_low_line"], seg["w_low"], seg["w_high"], seg["n_break"])
-    return iso_psd(n, seg["Gq_n0"], seg["w"])
+    return road_psd(np.asarray(n, float), *segment_spectrum(seg))
 
 
 def segment_psd_rows(rep: Replica, time, segments: list, band_m=(0.5, 20.0)) -> list:

@@ -78,7 +78,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from eroad.errors import EroadInputError
-from inverse.pipeline import AT_BOUND_TOL
+from inverse.pipeline import w_bound_side
 from inverse.spectral import N0, ParamBounds
 
 #: starting break frequencies per segment, log-even inside the band (3: on 40 one-slope and 10
@@ -193,8 +193,7 @@ def select_segment(linear, features, k: int, row, bounds: ParamBounds | None = N
            "one_slope": {"Gq_n0": math.exp(x1[0]), "w": float(x1[1])},
            "two_slope": {"Gq_n0_low_line": gq2, "Gd_n0": float(two_slope_psd([N0], gq2, wl, wh, nb)[0]),
                          "w_low": wl, "w_high": wh, "n_break": nb}}
-    pinned = [f"{name} = {v:.3g}" for name, v in (("w_low", wl), ("w_high", wh))
-              if v <= bounds.w[0] + AT_BOUND_TOL["w"] or v >= bounds.w[1] - AT_BOUND_TOL["w"]]
+    pinned = [f"{name} = {v:.3g}" for name, v in (("w_low", wl), ("w_high", wh)) if w_bound_side(v, bounds)]
     if delta > 0 and not pinned:
         return {"road_model": "two_slope", "w_low": wl, "w_high": wh, "n_break": nb, "ic_delta": delta,
                 "road_model_fit": fit}
@@ -266,6 +265,17 @@ def add_road_models(segments: list, fields: list) -> list:
     return segments
 
 
+def segment_spectrum(seg: dict) -> tuple:
+    """The road spectrum a summary.json segment reports: ``(Gq_n0, w, w2, n_break)``, the
+    two-slope refit (Gq_n0 of its low-frequency line, w_low, w_high, n_break) where the road
+    model chose two slopes, else the one-slope fit with ``w2 = n_break = None``
+    (``roadlib.psd.road_psd`` takes the four)."""
+    if seg.get("road_model") == "two_slope":
+        two = (seg.get("road_model_fit") or {}).get("two_slope", {})
+        return two["Gq_n0_low_line"], seg["w_low"], seg["w_high"], seg["n_break"]
+    return seg["Gq_n0"], seg["w"], None, None
+
+
 def road_params(params, segments: list) -> np.ndarray:
     """The fit's (K, 4) ``params`` with the road model of each segment: (K, 6), columns
     (Gq_n0, w, nmin, nmax, w2, n_break) for :func:`inverse.truck.road_from_params`.
@@ -284,11 +294,8 @@ def road_params(params, segments: list) -> np.ndarray:
     out = np.full((P.shape[0], 6), np.nan)
     out[:, :4] = P[:, :4]
     for k, s in enumerate(segments):
-        if s.get("road_model") != "two_slope":
-            continue
-        two = s["road_model_fit"]["two_slope"]
-        out[k, 0], out[k, 1] = two["Gq_n0_low_line"], s["w_low"]
-        out[k, 4], out[k, 5] = s["w_high"], s["n_break"]
+        if s.get("road_model") == "two_slope":
+            out[k, 0], out[k, 1], out[k, 4], out[k, 5] = segment_spectrum(s)
     return out
 
 

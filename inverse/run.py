@@ -241,11 +241,11 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             if selection == "linear" and n_cand > 0:
                 from inverse.linear_response import LinearRealisation
 
-                sel = select_realisation_linear(sim, LinearRealisation(sim), params, chans, seeds,
+                sel = select_realisation_linear(sim, LinearRealisation(sim), road_p, chans, seeds,
                                                 table_channels=table_ch, map_fn=sel_map, labels=labels,
                                                 per_round=max(1, workers))
             else:
-                sel = select_realisation(sim, params, chans, seeds, table_channels=table_ch, map_fn=sel_map,
+                sel = select_realisation(sim, road_p, chans, seeds, table_channels=table_ch, map_fn=sel_map,
                                          labels=labels, sides=False)
                 sel.update(method="simulation", n_simulated=len(seeds), fit_simulated=sel.pop("simulated_all")[0])
             timing["selection_s"] = _time.perf_counter() - t
@@ -263,7 +263,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         segs = inv.segments()
         from inverse.road_model import add_road_models, road_params, select_road_models
         add_road_models(segs, select_road_models(inv, sim, speed, road_model))
-        params = road_params(params, segs)
+        road_p = road_params(params, segs)
         timing["road_model_s"] = _time.perf_counter() - t
         sel_thread = None
         try:
@@ -327,7 +327,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                            "basis": c.get("basis", "simulated"),
                            **{f"rms_err_{k}": v for k, v in c["rms_err"].items()}} for c in sel["candidates"]]
                          ).to_csv(tmp / "tables" / "candidates.csv", index=False)
-            road = sim.road(params, sel["seed"])
+            road = sim.road(road_p, sel["seed"])
             road.save(tmp / "road.npz")
             road.save(tmp / "road.crg")
             write_json_atomic(tmp / "history.json", inv.fit.history)
