@@ -88,13 +88,13 @@ def band_mean_bias(w: float, b: float = THIRD_OCTAVE) -> float:
 
 
 def fitted_psd(f: dict, n: float) -> float:
-    """A fitted segment's road PSD at ``n`` [cycles/m] [m^3]: one ISO slope, or two when the
-    segment carries ``w2`` and ``n_break`` (roadlib.psd.road_psd)."""
-    if f.get("w2") is not None and f.get("n_break") is not None:
-        from roadlib.psd import road_psd
+    """A fitted segment's road PSD at ``n`` [cycles/m] [m^3]: the spectrum the segment
+    reports (``inverse.road_model.segment_spectrum``: two slopes where the road model chose
+    them, else the one-slope fit), as handed on to road.npz."""
+    from inverse.road_model import segment_spectrum
+    from roadlib.psd import road_psd
 
-        return float(road_psd(n, f["Gq_n0"], f["w"], f["w2"], f["n_break"]))
-    return float(f["Gq_n0"] * (n / 0.1) ** -f["w"])
+    return float(road_psd(n, *segment_spectrum(f)))
 
 
 def reference_axle_x(truth: dict, t) -> np.ndarray:
@@ -294,6 +294,50 @@ def table(cases: list) -> str:
     return "\n".join(lines)
 
 
+def score_run(ds: Path, scen: str, summ: dict) -> dict:
+    """One inversion's ``summary.json`` scored against the truth of its dataset ``ds``."""
+    from drives.synth import read_truth
+
+    truth = read_truth(ds)
+    if scen == "second_measured":   # no true ISO segment: the driven profile, fitted (measured_truth)
+        mtruth = measured_truth(ds, truth)
+        case = score_case(mtruth, summ)
+        for r, s0, s1 in zip(case["segments"], truth["segments"], mtruth["segments"]):
+            r.update(oracle=None, Gq_profile_file=s0["Gq_n0"], w_profile_file=s0["w"],
+                     x_start=s1["x_start"], x_end=s1["x_end"])
+        case["profile"] = profile_scores(ds, truth, summ)
+    else:
+        case = score_case(truth, summ)
+        for r, o in zip(case["segments"], oracle_fits(ds, truth)):
+            r["oracle"] = o
+    case["fit_model"] = summ.get("fit", {}).get("model")
+    loop = summ.get("closed_loop")
+    if loop is not None:
+        case["closed_loop"] = {k: loop.get(k) for k in ("verdict", "confidence", "effects", "corrected")}
+        if loop.get("corrected") and scen != "second_measured":
+            case["nominal"] = score_case(truth, {"segments": loop["nominal_segments"]})["segments"]
+    return case
+
+
+def rescore(root: Path, data_root: Path) -> list:
+    """Score again every case of ROOT/results.jsonl from its saved ``run-SEED/summary.json``
+    (e.g. after a change of the scoring); the new records go to ROOT/results-rescored.jsonl,
+    the old file is kept."""
+    cases = []
+    for line in (root / "results.jsonl").read_text().splitlines():
+        old = json.loads(line)
+        if "skipped" in old:
+            continue
+        summ = json.loads((root / f"run-{old['seed']}" / "summary.json").read_text())
+        case = score_run(data_root / f"{old['scenario']}-{old['seed']}", old["scenario"], summ)
+        case.update(seed=old["seed"], scenario=old["scenario"], wall_s=old["wall_s"])
+        cases.append(case)
+    with (root / "results-rescored.jsonl").open("w") as f:
+        for c in cases:
+            f.write(json.dumps(c) + "\n")
+    return sorted(cases, key=lambda c: c["seed"])
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=20)
@@ -331,7 +375,14 @@ def main(argv=None) -> int:
                     help="with --effects-auto: use the diagnoses of an earlier --effects-auto root "
                          "(ROOT/run-SEED/diagnose) instead of diagnosing each drive again; the diagnosis "
                          "does not depend on the inversion's options (e.g. --fit)")
+    ap.add_argument("--rescore", action="store_true",
+                    help="score the saved runs of --root again against the truths under --data-root "
+                         "(no inversion); writes ROOT/results-rescored.jsonl and prints the table")
     a = ap.parse_args(argv)
+    if a.rescore:
+        root = Path(a.root)
+        print(report(rescore(root, Path(a.data_root) if a.data_root else root)))
+        return 0
     if a.diagnoses and not a.effects_auto:
         ap.error("--diagnoses needs --effects-auto")
     if a.measured_every and a.scenario != "second":
@@ -394,25 +445,8 @@ def main(argv=None) -> int:
         else:
             summ = run_inversion(blind, root / f"run-{seed}", **inv)
         wall = time.perf_counter() - t0
-        truth = read_truth(ds)
-        if scen == "second_measured":   # no true ISO segment: the driven profile, fitted (measured_truth)
-            mtruth = measured_truth(ds, truth)
-            case = score_case(mtruth, summ)
-            for r, s0, s1 in zip(case["segments"], truth["segments"], mtruth["segments"]):
-                r.update(oracle=None, Gq_profile_file=s0["Gq_n0"], w_profile_file=s0["w"],
-                         x_start=s1["x_start"], x_end=s1["x_end"])
-            case["profile"] = profile_scores(ds, truth, summ)
-        else:
-            case = score_case(truth, summ)
-            for r, o in zip(case["segments"], oracle_fits(ds, truth)):
-                r["oracle"] = o
-        case.update(seed=seed, scenario=scen, wall_s=wall,
-                    fit_model=summ.get("fit", {}).get("model"))
-        loop = summ.get("closed_loop")
-        if loop is not None:
-            case["closed_loop"] = {k: loop.get(k) for k in ("verdict", "confidence", "effects", "corrected")}
-            if loop.get("corrected") and scen != "second_measured":
-                case["nominal"] = score_case(truth, {"segments": loop["nominal_segments"]})["segments"]
+        case = score_run(ds, scen, summ)
+        case.update(seed=seed, scenario=scen, wall_s=wall)
         with res_file.open("a") as f:
             f.write(json.dumps(case) + "\n")
         done[seed] = case

@@ -93,10 +93,15 @@ def test_measured_truth_and_profile_scores_use_the_driven_window(tmp_path):
 def test_fitted_psd_one_and_two_slopes():
     f = {"Gq_n0": 2.0e-4, "w": 2.5}
     assert B.fitted_psd(f, 1.0) == pytest.approx(2.0e-4 * 10.0 ** -2.5, rel=1e-12)
-    # two slopes: w below the break at 0.5 cycles/m, w2 above (continuous at the break)
-    f2 = dict(f, w2=3.5, n_break=0.5)
+    # two slopes, as summary.json reports them (road_model "two_slope": w_low below the break at
+    # 0.5 cycles/m, w_high above, Gq_n0 of the low-frequency line in road_model_fit; the one-slope
+    # Gq_n0 / w beside them must not be read -- the bug this replaces read only those)
+    f2 = dict(f, road_model="two_slope", w_low=2.5, w_high=3.5, n_break=0.5, Gq_n0=9.9e-4, w=1.7,
+              road_model_fit={"two_slope": {"Gq_n0_low_line": 2.0e-4}})
     assert B.fitted_psd(f2, 1.0) == pytest.approx(2.0e-4 * 5.0 ** -2.5 * 2.0 ** -3.5, rel=1e-12)
     assert B.fitted_psd(f2, 0.3) == pytest.approx(B.fitted_psd(f, 0.3), rel=1e-12)
+    # a one-slope segment the road model looked at keeps its one-slope fit
+    assert B.fitted_psd(dict(f, road_model="one_slope"), 1.0) == pytest.approx(B.fitted_psd(f, 1.0))
 
 
 def test_table_pairs_each_oracle_with_its_own_segment():
