@@ -49,6 +49,14 @@ def test_same_summary_without_truth(short_drive, tmp_path):
     for key in ("localization", "ranking", "verdict", "how_far", "transmissibility"):
         assert key in a
     assert a["verdict"] == "leaf_friction"
+    # what a correct model's signature reaches on this drive: the nominal model against its
+    # own records on 4 other road phases.  The two-input estimate, which the road does not
+    # enter, stays within the fixed threshold 2 for a correct model (0.3-0.5 measured here);
+    # the single-input one moves with the road (1.2-1.8 here, 4-13 on other drives)
+    cm2 = a["signature_two_input"]["chi2_correct_model"]
+    assert len(cm2) == 4 and all(0.0 < v < 2.0 for v in cm2)
+    cm1 = a["signature"]["chi2_correct_model"]
+    assert len(cm1) == 4 and all(v > 0.0 for v in cm1)
     assert (tmp_path / "a" / "report.md").is_file()
     assert (tmp_path / "a" / "figures" / "heatmap.png").is_file()
     # an existing run is not overwritten without --force

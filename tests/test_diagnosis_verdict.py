@@ -104,6 +104,26 @@ def test_partial_signature_names_the_effect_but_not_clearly():
     assert decide(_summary(chi2=(9.0, 9.0)))["verdict"] == "unexplained"
 
 
+def test_signature_is_held_to_what_a_correct_model_reaches_on_the_drive():
+    """An input-side effect (sensor low-pass, tyre enveloping, speed scale) leaves the
+    transmissibility as the nominal model's; where the nominal model scores 3-3.6 against its
+    OWN records on other road phases, 3.1 is what a correct model reaches there, not a
+    disagreement.  Above that level the test is as before; without surrogate values too."""
+    s = _summary(chi2=(3.1, 3.1))
+    assert decide(s)["verdict"] == "unexplained"                     # no surrogate values: 2 asked
+    s["signature"]["chi2_correct_model"] = [2.4, 3.6, 3.0, None]
+    d = decide(s)
+    assert d["verdict"] == "leaf_friction" and d["signature_agrees"] is True
+    assert d["signature_max"] == pytest.approx(3.6)
+    s["signature"]["chi2_model"] = 4.5                              # above the drive's own level
+    d = decide(s)
+    assert d["verdict"] == "unexplained" and "against itself" in d["reason"]
+    # surrogate values below the fixed threshold never tighten it
+    s2 = _summary(chi2=(3.0, 1.9))
+    s2["signature"]["chi2_correct_model"] = [0.8, 1.1]
+    assert decide(s2)["signature_max"] == SIGNATURE_CHI2_MAX and decide(s2)["verdict"] == "leaf_friction"
+
+
 def test_identified_effect_with_a_remainder_drives_the_correction():
     from diagnosis.closed_loop import effects_from_diagnosis
 
