@@ -66,7 +66,9 @@ def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool 
     nominal inversion's rows where a closed-loop run (``bench_inverse.py --effects-auto``)
     corrected the drive, i.e. the same drives inverted without the loop)."""
     rows = []
-    for line in (root / "results.jsonl").read_text().splitlines():
+    # a set re-scored after a change of the scoring (bench_inverse.py --rescore) is read re-scored
+    res = root / "results-rescored.jsonl"
+    for line in (res if res.is_file() else root / "results.jsonl").read_text().splitlines():
         case = json.loads(line)
         if profile:
             segs = profile_rows(case, min_s)
@@ -159,6 +161,10 @@ def main(argv=None) -> int:
     ap.add_argument("--open-loop", action="store_true",
                     help="for closed-loop sets (bench_inverse.py --effects-auto), also score the same "
                          "drives' nominal inversions (NAME/open-loop)")
+    ap.add_argument("--beta-scan", action="store_true",
+                    help="print each set's coverage for a grid of the level terms' BETA "
+                         "(ln Gq(n0) and ln G(n_best) alike; w keeps its constant): does one value "
+                         "serve every set?")
     a = ap.parse_args(argv)
     sets = {}
     for item in a.sets:
@@ -215,6 +221,17 @@ def main(argv=None) -> int:
     for name, rows in {**sets, **extra}.items():
         c = accuracy(rows)
         print(f"| {name} | {c['n']} | {100 * c['g1'][0]:.0f} % | {100 * c['class'][0]:.0f} % |")
+    if a.beta_scan:
+        names = list({**sets, **extra})
+        print("\n| BETA (ln Gq(n0), ln G(n_best)) | " + " | ".join(names) + " |")
+        print("|---|" + "---|" * len(names))
+        for b in (0.0, 0.03, 0.1, 0.2, 0.3, 0.5, 1.0):
+            c = {**const, "BETA": {**const["BETA"], "ln_Gq_n0": b, "ln_G_n_best": b}}
+            cells = []
+            for name in names:
+                cv = coverage({**sets, **extra}[name], c)
+                cells.append(f"{100 * cv['ln_Gq_n0'][0]:.0f} / {100 * cv['ln_G_n_best'][0]:.0f} %")
+            print(f"| {b:g} | " + " | ".join(cells) + " |")
     if a.calibrate:   # out of sample on the calibration family: odd seeds calibrate even ones and back
         rows = sets[a.calibrate]
         for part, other in ((1, 0), (0, 1)):
