@@ -26,7 +26,10 @@ Vocabulary
        model, the calibrated model's axle-to-body transmissibility (a ratio of channels
        of one record: the road cancels) matches the measurement to within
        ``SIGNATURE_CHI2_MAX`` (mean z^2 over the tested pair x band cells; about 1 for a
-       correct model) -- or, where the nominal model's is off, removes at least
+       correct model), or to within what the nominal model reaches against its own records
+       on other road phases of the same drive where that is higher
+       (:func:`signature_threshold`; the single-input ratio is not road-free on a four-axle
+       truck) -- or, where the nominal model's is off, removes at least
        ``SIGNATURE_SHARE_MIN`` of its excess (:func:`signature_agrees`).  Which
        transmissibility: ``SIGNATURE_METHOD`` (default ``single_input``; ``two_input``: a
        station's body acceleration on both of its axle accelerations, which the cross-track
