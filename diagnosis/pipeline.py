@@ -1174,23 +1174,24 @@ def _set_terms(sc, terms, n_null: int) -> list:
     return sur
 
 
-#: surrogate records of the nominal model (other road phases) that give what a correct model's
-#: signature reaches on a drive (:func:`signature_null`); about 1 s of simulation each
+#: surrogate records of the candidate model (other road phases) that give what a correct
+#: model's signature reaches on a drive (:func:`signature_null`); about 1 s of simulation each
 SIGNATURE_NULL_N = 4
 
 
-def signature_null(model: TruckModel, sig: Signals, sim: Signals, seed: int,
+def signature_null(model: TruckModel, sig: Signals, sim: Signals, seed: int, effects=None,
                    n: int = SIGNATURE_NULL_N) -> dict:
-    """What a correct model's road-independent signature reaches on this drive.
+    """What the signature of a correct model reaches on this drive.
 
-    The nominal model's record ``sim`` (road phase ``seed + 1``, as the signature's) against
-    ``n`` surrogate measurements the nominal model makes itself on other road phases
-    (``seed + 2`` ...; same fitted road statistics, speed and sensor noise): the mean z^2 of
-    the single-input and of the two-input axle-to-body transmissibility
-    (:func:`diagnosis.verdict.transmissibility_chi2`).  About 1 for an estimator the road
-    does not enter; the single-input ratio of a four-axle truck is not such an estimator
-    (docs/diagnosis.md), and the verdict holds a candidate to what the nominal model meets
-    against itself (:func:`diagnosis.verdict.signature_threshold`).
+    The model with ``effects`` (the candidate; None: the nominal model) as recorded in
+    ``sim`` (road phase ``seed + 1``, as the signature's) against ``n`` surrogate
+    measurements the same model makes on other road phases (``seed + 2`` ...; same fitted
+    road statistics, speed and sensor noise): the mean z^2 of the single-input and of the
+    two-input axle-to-body transmissibility (:func:`diagnosis.verdict.transmissibility_chi2`).
+    If the candidate were the truck, its signature against the measurement would scatter
+    like this.  About 1 for an estimator the road does not enter; the single-input ratio
+    of a four-axle truck is not such an estimator (docs/diagnosis.md), and the verdict holds
+    a candidate to what it meets against itself (:func:`diagnosis.verdict.signature_threshold`).
 
     Returns
     -------
@@ -1204,8 +1205,8 @@ def signature_null(model: TruckModel, sig: Signals, sim: Signals, seed: int,
     out = {"single_input": [], "two_input": []}
     for j in range(int(n)):
         sd = seed + 2 + j
-        surr = Signals(sig.time, model.add_noise(model.run({}, 0.0, T, sd), sd), dict(sig.units),
-                       sig.speed, {"model": f"nominal, road phase {sd}"})
+        surr = Signals(sig.time, model.add_noise(model.run(effects or {}, 0.0, T, sd), sd),
+                       dict(sig.units), sig.speed, {"model": f"road phase {sd}"})
         out["single_input"].append(transmissibility_chi2(transmissibility(surr, sim))[0])
         t2 = two_input_or_none(surr, sim)
         if t2 is not None:
@@ -1351,7 +1352,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         simw = model.run(ranking.winner.effects, 0.0, T, seed + 1)
         simw = Signals(sig.time, model.add_noise(simw, seed + 1), dict(sig.units), sig.speed,
                        {"model": ranking.winner.effect})
-        null = signature_null(model, sig, sim, seed)
+        null = signature_null(model, sig, simw, seed, effects=ranking.winner.effects)
         sig_w = signature(ranking.winner.effect, tr, transmissibility(sig, simw),
                           null=null["single_input"])
         tr2w = two_input_or_none(sig, simw) if tr2 is not None else None

@@ -410,8 +410,8 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                 continue
             tag = S.get("method", "single_input")
             cm = [v for v in S.get("chi2_correct_model") or [] if v is not None]
-            ref = (f"a correct model -- the nominal model against its own records on other "
-                   f"road phases -- reaches {min(cm):.2g}-{max(cm):.2g} here" if cm else
+            ref = (f"the {S['model']} model against its own records on other road phases "
+                   f"reaches {min(cm):.2g}-{max(cm):.2g} here" if cm else
                    "about 1 for a correct model")
             L.append(f" {what} against the measurement (mean z^2 over {S['n_cells']} cells; "
                      f"{ref}): nominal {_fmt(S['chi2_nominal'])}, with "

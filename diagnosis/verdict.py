@@ -26,7 +26,7 @@ Vocabulary
        model, the calibrated model's axle-to-body transmissibility (a ratio of channels
        of one record: the road cancels) matches the measurement to within
        ``SIGNATURE_CHI2_MAX`` (mean z^2 over the tested pair x band cells; about 1 for a
-       correct model), or to within what the nominal model reaches against its own records
+       correct model), or to within what the candidate model reaches against its own records
        on other road phases of the same drive where that is higher
        (:func:`signature_threshold`; the single-input ratio is not road-free on a four-axle
        truck) -- or, where the nominal model's is off, removes at least
@@ -116,8 +116,8 @@ class Signature:
     pairs_off: tuple = ()
     method: str = "single_input"
     n_unresolved: int | None = None
-    #: mean z^2 of the nominal model's record against surrogate measurements the nominal
-    #: model made on other road phases of the same drive: what a correct model reaches here
+    #: mean z^2 of the candidate model's record against surrogate measurements the same
+    #: model made on other road phases of the same drive: what it would reach if it were right
     chi2_null: tuple = ()
 
     def record(self) -> dict:
@@ -166,11 +166,11 @@ def signature(model_name: str, tr_nominal, tr_model, method: str = "single_input
 
 def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_MAX) -> float:
     """The largest mean z^2 at which a signature agrees on this drive: ``signature_max``, or
-    the largest value the nominal model reached against its own surrogate records
-    (``chi2_correct_model``) where that is higher -- a correct model is not held to a
-    standard it does not meet itself (on a four-axle truck the single-input ratio moves with
-    the road's cross-track coherence: 4-13 for the nominal model against itself on one
-    blind drive, docs/diagnosis.md)."""
+    the largest value the candidate model reached against its own surrogate records on
+    other road phases (``chi2_correct_model``) where that is higher -- a model is not held to
+    a standard it would not meet if it were right (on a four-axle truck the single-input
+    ratio moves with the road's cross-track coherence: 4-13 for the nominal model against
+    itself on one blind drive, docs/diagnosis.md)."""
     null = [v for v in (record.get("chi2_correct_model") or []) if v is not None and math.isfinite(v)]
     return max([float(signature_max)] + null)
 
@@ -338,7 +338,7 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     if agrees is False:
         short.append(f"its {what} still disagrees with the measurement "
                      f"(mean z^2 {c1:.2g}, nominal {c0:.2g}, at most {sig_max:.2g} asked"
-                     + (" -- what the nominal model reaches against itself here" if sig_max > signature_max
+                     + (" -- what the model reaches against itself here" if sig_max > signature_max
                         else "")
                      + (f"; off: {', '.join(sig.get('pairs_off', [])[:4])}" if sig.get("pairs_off")
                         else "") + ")")

@@ -49,8 +49,8 @@ def test_same_summary_without_truth(short_drive, tmp_path):
     for key in ("localization", "ranking", "verdict", "how_far", "transmissibility"):
         assert key in a
     assert a["verdict"] == "leaf_friction"
-    # what a correct model's signature reaches on this drive: the nominal model against its
-    # own records on 4 other road phases.  The two-input estimate, which the road does not
+    # what a correct model's signature reaches on this drive: the winner (leaf friction)
+    # against its own records on 4 other road phases.  The two-input estimate, which the road does not
     # enter, stays within the fixed threshold 2 for a correct model (0.3-0.5 measured here);
     # the single-input one moves with the road (1.2-1.8 here, 4-13 on other drives)
     cm2 = a["signature_two_input"]["chi2_correct_model"]
