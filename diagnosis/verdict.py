@@ -164,15 +164,36 @@ def signature(model_name: str, tr_nominal, tr_model, method: str = "single_input
                      tuple(float(v) for v in null))
 
 
-def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_MAX) -> float:
-    """The largest mean z^2 at which a signature agrees on this drive: ``signature_max``, or
-    the largest value the candidate model reached against its own surrogate records on
-    other road phases (``chi2_correct_model``) where that is higher -- a model is not held to
-    a standard it would not meet if it were right (on a four-axle truck the single-input
-    ratio moves with the road's cross-track coherence: 4-13 for the nominal model against
-    itself on one blind drive, docs/diagnosis.md)."""
-    null = [v for v in (record.get("chi2_correct_model") or []) if v is not None and math.isfinite(v)]
-    return max([float(signature_max)] + null)
+#: one-sided level of the prediction bound on a correct model's signature (:func:`signature_threshold`)
+SIGNATURE_NULL_LEVEL = 0.95
+
+
+def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_MAX,
+                        level: float = SIGNATURE_NULL_LEVEL) -> float:
+    """The largest mean z^2 at which a signature agrees on this drive.
+
+    ``signature_max``, or -- where it is higher -- the one-sided ``level`` prediction bound
+    of what the candidate model reaches against its own records on other road phases
+    (``chi2_correct_model``, n values): ln values taken as normal, ``exp(m + t_{n-1}(level)
+    s sqrt(1 + 1/n))`` with their mean ``m`` and sd ``s`` (one value: that value).  A model
+    is not held to a standard it would miss if it were right: on a four-axle truck the
+    single-input ratio moves with the road's cross-track coherence (4-13 for the nominal
+    model against itself on one blind drive, docs/diagnosis.md); at 0.95 a correct model is
+    rejected about once in 20.
+    """
+    null = [float(v) for v in (record.get("chi2_correct_model") or [])
+            if v is not None and math.isfinite(v) and v > 0]
+    if not null:
+        return float(signature_max)
+    if len(null) == 1:
+        return max(float(signature_max), null[0])
+    from scipy.stats import t as student_t
+
+    ln = np.log(null)
+    n = ln.size
+    bound = math.exp(float(ln.mean()) + float(student_t.ppf(level, n - 1)) * float(ln.std(ddof=1))
+                     * math.sqrt(1.0 + 1.0 / n))
+    return max(float(signature_max), bound)
 
 
 def chosen_signature(summary: Mapping, method: str = SIGNATURE_METHOD) -> tuple[dict, str]:

@@ -7,6 +7,7 @@ and nothing accepted is "none"; a calibration at a search-range edge is never "c
 """
 import math
 
+import numpy as np
 import pytest
 
 from diagnosis.verdict import (EDGE_TOL, SHARE_MIN, SIGNATURE_CHI2_MAX, decide, edge_parameters,
@@ -111,16 +112,20 @@ def test_signature_is_held_to_what_a_correct_model_reaches_on_the_drive():
     disagreement.  Above that level the test is as before; without surrogate values too."""
     s = _summary(chi2=(3.1, 3.1))
     assert decide(s)["verdict"] == "unexplained"                     # no surrogate values: 2 asked
-    s["signature"]["chi2_correct_model"] = [2.4, 3.6, 3.0, None]
+    null = [2.4, 3.6, 3.0]
+    s["signature"]["chi2_correct_model"] = null + [None]
     d = decide(s)
     assert d["verdict"] == "leaf_friction" and d["signature_agrees"] is True
-    assert d["signature_max"] == pytest.approx(3.6)
-    s["signature"]["chi2_model"] = 4.5                              # above the drive's own level
+    # the one-sided 95 % prediction bound of ln chi2 from 3 values: t(0.95, 2 dof) = 2.920
+    ln = np.log(null)
+    bound = math.exp(ln.mean() + 2.919986 * ln.std(ddof=1) * math.sqrt(1 + 1 / 3))
+    assert d["signature_max"] == pytest.approx(bound, rel=1e-5) and 3.6 < bound < 6.0
+    s["signature"]["chi2_model"] = bound * 1.05                     # above the drive's own level
     d = decide(s)
     assert d["verdict"] == "unexplained" and "against itself" in d["reason"]
     # surrogate values below the fixed threshold never tighten it
     s2 = _summary(chi2=(3.0, 1.9))
-    s2["signature"]["chi2_correct_model"] = [0.8, 1.1]
+    s2["signature"]["chi2_correct_model"] = [0.8, 1.1, 0.9, 1.0]
     assert decide(s2)["signature_max"] == SIGNATURE_CHI2_MAX and decide(s2)["verdict"] == "leaf_friction"
 
 
