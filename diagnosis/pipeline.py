@@ -1180,7 +1180,7 @@ SIGNATURE_NULL_N = 4
 
 
 def signature_null(model: TruckModel, sig: Signals, sim: Signals, seed: int, effects=None,
-                   n: int = SIGNATURE_NULL_N) -> dict:
+                   n: int = SIGNATURE_NULL_N, records=None) -> dict:
     """What the signature of a correct model reaches on this drive.
 
     The model with ``effects`` (the candidate; None: the nominal model) as recorded in
@@ -1193,6 +1193,9 @@ def signature_null(model: TruckModel, sig: Signals, sim: Signals, seed: int, eff
     of a four-axle truck is not such an estimator (docs/diagnosis.md), and the verdict holds
     a candidate to what it meets against itself (:func:`diagnosis.verdict.signature_threshold`).
 
+    ``records``: the n surrogate records' noise-free channels when already simulated
+    (``model.run(effects, 0, T, seed + 2 + j)``), else they are simulated here.
+
     Returns
     -------
     dict
@@ -1203,10 +1206,11 @@ def signature_null(model: TruckModel, sig: Signals, sim: Signals, seed: int, eff
 
     T = sig.time.size / sig.fs
     out = {"single_input": [], "two_input": []}
-    for j in range(int(n)):
+    for j in range(int(n) if records is None else len(records)):
         sd = seed + 2 + j
-        surr = Signals(sig.time, model.add_noise(model.run(effects or {}, 0.0, T, sd), sd),
-                       dict(sig.units), sig.speed, {"model": f"road phase {sd}"})
+        rec = model.run(effects or {}, 0.0, T, sd) if records is None else records[j]
+        surr = Signals(sig.time, model.add_noise(rec, sd), dict(sig.units), sig.speed,
+                       {"model": f"road phase {sd}"})
         out["single_input"].append(transmissibility_chi2(transmissibility(surr, sim))[0])
         t2 = two_input_or_none(surr, sim)
         if t2 is not None:
@@ -1223,6 +1227,37 @@ def two_input_or_none(measured, simulated):
     if not two_input_stations(measured, simulated):
         return None
     return transmissibility_two_input(measured, simulated)
+
+
+def _winner_signature(model: TruckModel, sig: Signals, sim: Signals, tr, tr2, ranking, seed: int,
+                      executor=None):
+    """The ranking winner's signature records (single- and two-input, each with what the
+    winner reaches against its own records, :func:`signature_null`) and the seconds taken;
+    ``(None, None, None)`` without a winner.  The winner's record (road phase ``seed + 1``)
+    and its surrogates run on ``executor`` when given."""
+    from diagnosis.compare import transmissibility
+    from diagnosis.verdict import signature
+
+    if ranking.winner is None:
+        return None, None, None
+    t = _time.perf_counter()
+    eff = ranking.winner.effects
+    T = sig.time.size / sig.fs
+    seeds = [seed + 1] + [seed + 2 + j for j in range(SIGNATURE_NULL_N)]
+    if executor is not None:
+        futs = [executor.submit(model.run, eff, 0.0, T, sd) for sd in seeds]
+        runs = [f.result() for f in futs]
+    else:
+        runs = [model.run(eff, 0.0, T, sd) for sd in seeds]
+    simw = Signals(sig.time, model.add_noise(runs[0], seeds[0]), dict(sig.units), sig.speed,
+                   {"model": ranking.winner.effect})
+    null = signature_null(model, sig, simw, seed, effects=eff, records=runs[1:])
+    sig_w = signature(ranking.winner.effect, tr, transmissibility(sig, simw), null=null["single_input"])
+    sig_w2 = None
+    tr2w = two_input_or_none(sig, simw) if tr2 is not None else None
+    if tr2w is not None:
+        sig_w2 = signature(ranking.winner.effect, tr2, tr2w, method="two_input", null=null["two_input"])
+    return sig_w, sig_w2, _time.perf_counter() - t
 
 
 def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quick: bool = False,
@@ -1270,7 +1305,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
 
     from diagnosis.compare import distribution_shape, front_rear, transmissibility
     from diagnosis.report import write_report
-    from diagnosis.verdict import SIGNATURE_METHOD, search_ranges, signature
+    from diagnosis.verdict import SIGNATURE_METHOD, search_ranges
     from diagnosis.which import combine_folds, rank_effects
     from diagnosis.where import localize
     from vehicles.params import load_vehicle
@@ -1335,31 +1370,19 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                                  progress=progress, delay=delay_term(model),
                                  shape=shape_term(model), **kw)
                     for c, h, sd in splits]
+        ranking = rankings[0] if folds == 1 else combine_folds(rankings)
+        timing["ranking_s"] = _time.perf_counter() - t
+        sig_w, sig_w2, t_sig = _winner_signature(model, sig, sim, tr, tr2, ranking, seed, ex)
+        if t_sig is not None:
+            timing["signature_s"] = t_sig
     finally:
         if ex is not None:
             ex.shutdown()
-    ranking = rankings[0] if folds == 1 else combine_folds(rankings)
-    timing["ranking_s"] = _time.perf_counter() - t
-
     # the winner's road-independent signature: its axle-to-body transmissibility on the
     # nominal model's road and seed, against the measurement (diagnosis.verdict); both the
     # single-input ratio (``signature``, as before) and the two-input estimate
     # (``signature_two_input``, where both sides are measured); the verdict uses
     # diagnosis.verdict.SIGNATURE_METHOD
-    sig_w = sig_w2 = None
-    if ranking.winner is not None:
-        t = _time.perf_counter()
-        simw = model.run(ranking.winner.effects, 0.0, T, seed + 1)
-        simw = Signals(sig.time, model.add_noise(simw, seed + 1), dict(sig.units), sig.speed,
-                       {"model": ranking.winner.effect})
-        null = signature_null(model, sig, simw, seed, effects=ranking.winner.effects)
-        sig_w = signature(ranking.winner.effect, tr, transmissibility(sig, simw),
-                          null=null["single_input"])
-        tr2w = two_input_or_none(sig, simw) if tr2 is not None else None
-        if tr2w is not None:
-            sig_w2 = signature(ranking.winner.effect, tr2, tr2w, method="two_input",
-                               null=null["two_input"])
-        timing["signature_s"] = _time.perf_counter() - t
     timing["total_s"] = _time.perf_counter() - wall0
 
     meta = {
