@@ -1372,17 +1372,17 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                     for c, h, sd in splits]
         ranking = rankings[0] if folds == 1 else combine_folds(rankings)
         timing["ranking_s"] = _time.perf_counter() - t
+        # the winner's road-independent signature: its axle-to-body transmissibility on the
+        # nominal model's road and seed, against the measurement (diagnosis.verdict); both the
+        # single-input ratio (``signature``) and the two-input estimate (``signature_two_input``,
+        # where both sides are measured), each with what the winner reaches against itself;
+        # the verdict uses diagnosis.verdict.SIGNATURE_METHOD
         sig_w, sig_w2, t_sig = _winner_signature(model, sig, sim, tr, tr2, ranking, seed, ex)
         if t_sig is not None:
             timing["signature_s"] = t_sig
     finally:
         if ex is not None:
             ex.shutdown()
-    # the winner's road-independent signature: its axle-to-body transmissibility on the
-    # nominal model's road and seed, against the measurement (diagnosis.verdict); both the
-    # single-input ratio (``signature``, as before) and the two-input estimate
-    # (``signature_two_input``, where both sides are measured); the verdict uses
-    # diagnosis.verdict.SIGNATURE_METHOD
     timing["total_s"] = _time.perf_counter() - wall0
 
     meta = {
