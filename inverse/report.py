@@ -72,8 +72,8 @@ ROAD_MODEL_NOTE = (
     "segment's response features are explained better by two slopes, w_low below n_break and "
     "w_high above (continuous at n_break), by enough to pay their two extra parameters: "
     "bic_gain_two_slope = BIC(one) - BIC(two) on the fit's weighted residual, two slopes when > 0 "
-    "(docs/road_model.md); for one slope w_low = w_high = w. The road files and Table 2 use the "
-    "one-slope fit.")
+    "(docs/road_model.md); for one slope w_low = w_high = w. The road files, Table 2 and the "
+    "studies use the two slopes where road_model says two_slope, else the one-slope fit.")
 
 
 def table1_note(fit_quality: dict | None = None, road_model: bool = True, segments=None) -> str:

@@ -8,8 +8,9 @@ explains them enough better to pay for its two extra parameters.  Real road prof
 often bend (Andren 2006, Int. J. Vehicle Design 40; Kropac and Mucka 2004, Int. J.
 Vehicle Design 36); a one-slope fit to a bent spectrum puts w on a bound and the level
 where the line happens to cross n0.  What it is not: a new fit of the band or of the
-realisation, nor a change to the road the run synthesises (Table 2, the road files and
-Figure 11 keep the one-slope fit; see docs/road_model.md).
+realisation.  A segment reported two-slope hands its two slopes on (:func:`road_params`:
+road.npz, the realisation selection, Table 2, Figure 11, the chassis study); see
+docs/road_model.md.
 
 Method (docs/road_model.md has the derivation and the measured rates)
 ------------------------------------------------------------------------
