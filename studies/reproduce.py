@@ -224,7 +224,8 @@ def _manifest(run: Path) -> list:
     return manifest_rows(run, [(item, f"{step}/{pattern}", code) for item, step, pattern, code in MANIFEST])
 
 
-def _manifest_md(rows: list, timings: dict, fit_quality: dict | None = None) -> str:
+def _manifest_md(rows: list, timings: dict, fit_quality: dict | None = None,
+                 diagnosis_s: float | None = None) -> str:
     lines = ["# eroad reproduce: manifest", "",
              "Each paper item, the file(s) that show it (relative to this folder) and the "
              "code that made them.", ""]
@@ -239,6 +240,9 @@ def _manifest_md(rows: list, timings: dict, fit_quality: dict | None = None) -> 
         lines.append(f"| {r['item']} | {files} | `{r['code']}` |")
     lines += ["", "## Timing", "", "| step | wall [s] |", "|---|---|"]
     lines += [f"| {k} | {v:.1f} |" for k, v in timings.items()]
+    if diagnosis_s is not None:
+        lines += ["", f"invert includes the diagnosis that closes the loop ({diagnosis_s:.0f} s, "
+                      "diagnose/run.json); the diagnose step copies it."]
     return "\n".join(lines) + "\n"
 
 
@@ -306,7 +310,9 @@ def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False
         write_json_atomic(tmp / "summary.json", _jsonable(summary))
         write_json_atomic(tmp / "manifest.json", rows)
         fq = results.get("invert", {}).get("fit_quality") if isinstance(results.get("invert"), dict) else None
-        (tmp / "manifest.md").write_text(_manifest_md(rows, timings, fq))
+        dg = tmp / "invert" / "diagnose" / "run.json"
+        dg_s = json.loads(dg.read_text()).get("wall_s") if dg.is_file() else None
+        (tmp / "manifest.md").write_text(_manifest_md(rows, timings, fq, dg_s))
         target = out if record["status"] == "complete" else out.with_name(f"{out.name}.failed-{os.getpid()}")
         if target.exists():
             target.rmdir()  # empty (checked above)
