@@ -13,9 +13,11 @@ def register(subparsers) -> None:
         "diagnose", help="sim-to-real gap diagnosis of a measured dataset",
         description="Diagnose the gap between a measured dataset and the nominal truck model: "
         "where (channel x third-octave band x road segment), which effect of the library "
-        "closes it (calibrated on alternate time windows, scored on the others, 'none' when "
-        "nothing beats noise) and how far. Writes report.md, figures/ and summary.json into "
-        "RUN. The dataset's truth/ folder is never read.")
+        "closes it (calibrated on alternate time windows, scored on the others) and how far. "
+        "The verdict: 'none' (no gap beyond noise), an effect (it explains a share of the gap "
+        "and its axle-to-body transmissibility agrees), or 'unexplained' (a gap no library "
+        "effect explains: what is left is reported). Writes report.md, figures/ and "
+        "summary.json into RUN. The dataset's truth/ folder is never read.")
     p.add_argument("dataset", metavar="DATASET", help="dataset folder (measurement format)")
     p.add_argument("--vehicle", metavar="FILE", default=None,
                    help="nominal vehicle (built-in id or TOML file; default: the dataset's)")
