@@ -81,6 +81,9 @@ def main(argv=None) -> int:
     ap.add_argument("--signature-method", choices=("single_input", "two_input"), default=None,
                     help="with --rescore: the transmissibility the verdict checks (default: "
                          "diagnosis.verdict.SIGNATURE_METHOD)")
+    ap.add_argument("--signature-null", action="store_true",
+                    help="with --rescore: hold the signature to the candidate's own scatter "
+                         "(diagnosis.verdict.signature_threshold; not the default)")
     args = ap.parse_args(argv)
 
     if args.sweep:
@@ -104,7 +107,8 @@ def main(argv=None) -> int:
 
         th = {k: v for k, v in (("share_min", args.share_min), ("signature_max", args.signature_max),
                                 ("signature_share", args.signature_share),
-                                ("signature_method", args.signature_method)) if v is not None}
+                                ("signature_method", args.signature_method),
+                                ("signature_null", args.signature_null or None)) if v is not None}
         out = rescore(args.out, **th)
         print(f"thresholds {th or 'defaults'}")
         print(format_confusion(out["score"]))

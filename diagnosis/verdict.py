@@ -76,6 +76,15 @@ SIGNATURE_CHI2_MAX = 2.0
 #: leaf friction on the embedded drive, whose truth also has a flexible frame, 0.28;
 #: kept by the 40-drive blind set's sweep, docs/diagnosis.md)
 SIGNATURE_SHARE_MIN = 0.15
+#: least improvement of a named effect over the nominal model, in sd of its paired noise
+#: (``improvement / null_improvement_sd`` of its ranking entry), for confidence "clear" and for
+#: ``identified`` (what the closed loop corrects with).  The ranking accepts against the paired
+#: null's mean, which is negative where calibrations fit noise, so an effect can be accepted
+#: while improving on the nominal model by less than 2 sd.  Set after a blind failure: on 20
+#: independent-truck drives without a library effect, leaf friction 337 N was named "clear" at
+#: 1.7 sd; on the saved blind sets the rule downgrades one right "clear" (nominal case 2, leaf
+#: friction 593 N at 1.7 sd) and no other (docs/diagnosis.md)
+CLEAR_Z_MIN = 3.0
 #: a calibrated parameter within this share of its search range (unit coordinates, log
 #: where searched in log) of either end is "at the edge"
 EDGE_TOL = 0.02
@@ -166,6 +175,15 @@ def signature(model_name: str, tr_nominal, tr_model, method: str = "single_input
 
 #: one-sided level of the prediction bound on a correct model's signature (:func:`signature_threshold`)
 SIGNATURE_NULL_LEVEL = 0.95
+#: does the verdict hold a candidate's signature to its own scatter (:func:`signature_threshold`)
+#: instead of the fixed ``SIGNATURE_CHI2_MAX``?  Built and measured, NOT the default: on the saved
+#: blind sets it named 2 more library effects right on our truck (8/16 -> 10/16) and changed
+#: nothing on the independent truck, but on 20 further drives of the independent truck without a
+#: library effect (the inversion benchmark's `second` set, diagnosed by the closed loop) it named
+#: an effect with confidence "clear" on 3 (damper asymmetry, a sensor low-pass on the measured
+#: road: their own scatter over 4 road phases spans 0.6-5.4, so the bound reaches 8-9) where the
+#: fixed threshold names 1 (docs/diagnosis.md, "Signature held to what a correct model reaches")
+SIGNATURE_USE_NULL = False
 
 
 def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_MAX,
@@ -293,13 +311,16 @@ def signature_agrees(c0, c1, signature_max: float = SIGNATURE_CHI2_MAX,
 def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
            signature_max: float = SIGNATURE_CHI2_MAX,
            signature_share: float = SIGNATURE_SHARE_MIN,
-           signature_method: str = SIGNATURE_METHOD) -> dict:
+           signature_method: str = SIGNATURE_METHOD,
+           signature_null: bool = SIGNATURE_USE_NULL) -> dict:
     """Verdict, confidence, reason and what is left, from a diagnosis summary.
 
     Reads ``summary["ranking"]`` (entries, accepted first), ``summary["ranking_decision"]``
     (the ranking's own verdict and confidence), ``summary["nominal"]``, the signature
     record :func:`chosen_signature` picks for ``signature_method`` (``signature_two_input``
-    or ``signature``) and ``summary["meta"]["search_ranges"]``.
+    or ``signature``) and ``summary["meta"]["search_ranges"]``.  ``signature_null``: hold the
+    signature to the candidate's own scatter (:func:`signature_threshold`, where the record
+    has ``chi2_correct_model``) rather than to ``signature_max`` alone.
 
     Returns
     -------
@@ -317,7 +338,7 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     win = next((e for e in ranking if e.get("effect") == rv and e.get("accepted")), None)
     thresholds = {"share_min": share_min, "signature_chi2_max": signature_max,
                   "signature_share_min": signature_share, "edge_tol": EDGE_TOL,
-                  "signature_method": signature_method}
+                  "signature_method": signature_method, "signature_null": bool(signature_null)}
     sig, sig_method = chosen_signature(summary, signature_method)
     base = {"explained_share": None, "closest": None, "edge": [], "signature_agrees": None,
             "signature_method": sig_method if sig else None, "identified": False,
@@ -343,7 +364,7 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     c0, c1 = sig.get("chi2_nominal"), sig.get("chi2_model")
     what = ("two-input axle-to-body transmissibility" if sig_method == "two_input"
             else "axle-to-body transmissibility")
-    sig_max = signature_threshold(sig, signature_max)
+    sig_max = signature_threshold(sig, signature_max) if signature_null else float(signature_max)
     agrees = signature_agrees(c0, c1, sig_max, signature_share)
     out = dict(base, explained_share=_f(share), closest=win["effect"], edge=edges,
                signature_agrees=agrees, signature_max=_f(sig_max), residual=residual(summary, win))
@@ -382,6 +403,12 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
         conf = "ambiguous"
         reason += (f"; calibrated at the edge of its search range ({', '.join(edges)}): the "
                    f"value is a bound, not an estimate")
+    z_abs = improvement_z(win)
+    weak = z_abs is not None and z_abs < CLEAR_Z_MIN
+    if weak:
+        conf = "ambiguous"
+        reason += (f"; it improves on the nominal model by only {z_abs:.1f} sd of its paired noise "
+                   f"({CLEAR_Z_MIN:g} asked for 'clear')")
     if not gap_present:
         # the paired comparison can see an effect the whole gap's road-phase scatter hides,
         # but then the share above is a ratio over a difference within noise (it can read
@@ -395,7 +422,17 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     # or value in doubt (a remainder beyond it does not), and there is a gap beyond noise to
     # correct: what a correction may use
     return dict(out, verdict=rv, confidence=conf, reason=reason,
-                identified=bool(rd.get("confidence") == "clear" and not edges and gap_present))
+                identified=bool(rd.get("confidence") == "clear" and not edges and gap_present
+                                and not weak))
+
+
+def improvement_z(entry: Mapping) -> float | None:
+    """A ranking entry's held-out improvement over the nominal model in sd of its paired
+    noise (``improvement / null_improvement_sd``); None where the entry lacks them."""
+    imp, sd = entry.get("improvement"), entry.get("null_improvement_sd")
+    if imp is None or sd is None or not sd > 0:
+        return None
+    return float(imp) / float(sd)
 
 
 def search_ranges(candidates: Sequence) -> dict:

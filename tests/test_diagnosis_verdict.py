@@ -111,22 +111,39 @@ def test_signature_is_held_to_what_a_correct_model_reaches_on_the_drive():
     its OWN records on other road phases, 3.1 is what it would reach if it were right, not a
     disagreement.  Above that level the test is as before; without surrogate values too."""
     s = _summary(chi2=(3.1, 3.1))
-    assert decide(s)["verdict"] == "unexplained"                     # no surrogate values: 2 asked
+    assert decide(s, signature_null=True)["verdict"] == "unexplained"   # no surrogate values: 2 asked
     null = [2.4, 3.6, 3.0]
     s["signature"]["chi2_correct_model"] = null + [None]
-    d = decide(s)
+    # not the default (docs/diagnosis.md): the fixed threshold still decides
+    assert decide(s)["verdict"] == "unexplained" and decide(s)["signature_max"] == SIGNATURE_CHI2_MAX
+    d = decide(s, signature_null=True)
     assert d["verdict"] == "leaf_friction" and d["signature_agrees"] is True
     # the one-sided 95 % prediction bound of ln chi2 from 3 values: t(0.95, 2 dof) = 2.920
     ln = np.log(null)
     bound = math.exp(ln.mean() + 2.919986 * ln.std(ddof=1) * math.sqrt(1 + 1 / 3))
     assert d["signature_max"] == pytest.approx(bound, rel=1e-5) and 3.6 < bound < 6.0
     s["signature"]["chi2_model"] = bound * 1.05                     # above the drive's own level
-    d = decide(s)
+    d = decide(s, signature_null=True)
     assert d["verdict"] == "unexplained" and "against itself" in d["reason"]
     # surrogate values below the fixed threshold never tighten it
     s2 = _summary(chi2=(3.0, 1.9))
     s2["signature"]["chi2_correct_model"] = [0.8, 1.1, 0.9, 1.0]
-    assert decide(s2)["signature_max"] == SIGNATURE_CHI2_MAX and decide(s2)["verdict"] == "leaf_friction"
+    d2 = decide(s2, signature_null=True)
+    assert d2["signature_max"] == SIGNATURE_CHI2_MAX and d2["verdict"] == "leaf_friction"
+
+
+def test_weak_improvement_is_never_clear_nor_identified():
+    """Accepted against a negative paired-null mean, an effect may improve on the nominal model
+    by under 2 sd of its paired noise (leaf friction 337 N named "clear" at 1.7 sd on a blind
+    independent-truck drive without a library effect): named, never "clear", not corrected with."""
+    s = _summary()
+    s["ranking"][0].update(improvement=0.051, null_improvement_sd=0.030, null_improvement_mean=-0.046)
+    d = decide(s)
+    assert (d["verdict"], d["confidence"], d["identified"]) == ("leaf_friction", "ambiguous", False)
+    assert "1.7 sd" in d["reason"]
+    s["ranking"][0].update(improvement=0.55)                         # 18 sd: clear as before
+    d = decide(s)
+    assert (d["confidence"], d["identified"]) == ("clear", True)
 
 
 def test_identified_effect_with_a_remainder_drives_the_correction():
