@@ -284,8 +284,9 @@ def plot_transmissibility(summary: Mapping, path: str | os.PathLike) -> Path:
     fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=3, fontsize=7)
     for ax in axes[max(0, len(pairs) - ncol):len(pairs)]:
         ax.set_xlabel("third-octave band centre [Hz]", fontsize=8)
-    fig.suptitle("axle-to-body transmissibility, ln|H_sim| - ln|H_meas| per band (independent "
-                 "of the road: a gap here is the vehicle's)", fontsize=9)
+    fig.suptitle("axle-to-body transmissibility (single input), ln|H_sim| - ln|H_meas| per band: "
+                 "mostly the vehicle's, but on a multi-axle truck the road's cross-track coherence "
+                 "still enters", fontsize=9)
     fig.savefig(path, dpi=130)
     return Path(path)
 
@@ -451,8 +452,12 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
         if "segments" in figures:
             L.append(f"Per segment:\n\n![per segment]({figures['segments']})\n")
     if summary.get("transmissibility") or summary.get("front_rear") or summary.get("distribution"):
-        L.append("## Road-independent comparisons\n")
-        L.append("These cancel the unknown road and isolate model error.\n")
+        L.append("## Comparisons the road mostly cancels\n")
+        L.append("Ratios of channels of one record: most of the unknown road cancels. Not all of "
+                 "it: a station's body acceleration answers both wheel tracks and the other axles, "
+                 "so the single-input ratio still depends on the road's cross-track coherence "
+                 "(a correct model can score several times 1 against itself on another road "
+                 "phase: the range under \"What is left\"); the two-input ratio removes that.\n")
     T = summary.get("transmissibility")
     if T:
         L.append("**Axle-to-body transmissibility** (ln|H_sim| - ln|H_meas|):\n")
