@@ -26,10 +26,9 @@ Vocabulary
        model, the calibrated model's axle-to-body transmissibility (a ratio of channels
        of one record: the road cancels) matches the measurement to within
        ``SIGNATURE_CHI2_MAX`` (mean z^2 over the tested pair x band cells; about 1 for a
-       correct model), or to within what the candidate model reaches against its own records
-       on other road phases of the same drive where that is higher
-       (:func:`signature_threshold`; the single-input ratio is not road-free on a four-axle
-       truck) -- or, where the nominal model's is off, removes at least
+       correct model; with ``signature_null``, not the default, or within what the candidate
+       model reaches against its own records on other road phases of the same drive,
+       :func:`signature_threshold`) -- or, where the nominal model's is off, removes at least
        ``SIGNATURE_SHARE_MIN`` of its excess (:func:`signature_agrees`).  Which
        transmissibility: ``SIGNATURE_METHOD`` (default ``single_input``; ``two_input``: a
        station's body acceleration on both of its axle accelerations, which the cross-track
@@ -41,8 +40,9 @@ Vocabulary
        (skewness) are terms of every gap the ranking scores, so 1. already asks them.
 
     ``confidence`` is ``clear`` when no rival sharing no effect comes within the
-    nominal-vs-nominal gap's sd and the calibrated parameter is not at an edge of its
-    search range; else ``ambiguous``.  A calibration at a range edge is never ``clear``.
+    nominal-vs-nominal gap's sd, the calibrated parameter is not at an edge of its
+    search range and the effect improves on the nominal model by at least ``CLEAR_Z_MIN``
+    sd of its paired noise; else ``ambiguous``.  A calibration at a range edge is never ``clear``.
 ``unexplained``
     A gap is there (nominal gap beyond noise, or an accepted candidate) and no library
     effect passes 1-3.  The closest candidate, the share it explains, the bands where
