@@ -214,22 +214,22 @@ def main(argv=None) -> int:
               + " | ".join(f"{100 * c[q][0]:.0f} %" for q in QUANTITIES) + " | "
               + " | ".join(f"{100 * c[q][1]:.0f} %" for q in QUANTITIES) + " |")
 
-    for name, rows in {**sets, **extra}.items():
+    scored = {**sets, **extra}
+    for name, rows in scored.items():
         line(name, coverage(rows, const))
     print("\n| set | segments >= %g s | G(1 cycle/m) within 20 %% | class right |" % a.min_s)
     print("|---|---|---|---|")
-    for name, rows in {**sets, **extra}.items():
+    for name, rows in scored.items():
         c = accuracy(rows)
         print(f"| {name} | {c['n']} | {100 * c['g1'][0]:.0f} % | {100 * c['class'][0]:.0f} % |")
     if a.beta_scan:
-        names = list({**sets, **extra})
-        print("\n| BETA (ln Gq(n0), ln G(n_best)) | " + " | ".join(names) + " |")
-        print("|---|" + "---|" * len(names))
+        print("\n| BETA (ln Gq(n0), ln G(n_best)) | " + " | ".join(scored) + " |")
+        print("|---|" + "---|" * len(scored))
         for b in (0.0, 0.03, 0.1, 0.2, 0.3, 0.5, 1.0):
             c = {**const, "BETA": {**const["BETA"], "ln_Gq_n0": b, "ln_G_n_best": b}}
             cells = []
-            for name in names:
-                cv = coverage({**sets, **extra}[name], c)
+            for rows in scored.values():
+                cv = coverage(rows, c)
                 cells.append(f"{100 * cv['ln_Gq_n0'][0]:.0f} / {100 * cv['ln_G_n_best'][0]:.0f} %")
             print(f"| {b:g} | " + " | ".join(cells) + " |")
     if a.calibrate:   # out of sample on the calibration family: odd seeds calibrate even ones and back

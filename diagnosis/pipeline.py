@@ -1174,41 +1174,33 @@ def _set_terms(sc, terms, n_null: int) -> list:
     return sur
 
 
-#: surrogate records of the candidate model (other road phases) that give what a correct
+#: surrogate records of the winner (other road phases) that give what a correct
 #: model's signature reaches on a drive (:func:`signature_null`); about 1 s of simulation each
 SIGNATURE_NULL_N = 4
 
 
-def signature_null(model: TruckModel, sig: Signals, sim: Signals, seed: int, effects=None,
-                   n: int = SIGNATURE_NULL_N, records=None) -> dict:
+def signature_null(model: TruckModel, sig: Signals, sim: Signals, records, seeds) -> dict:
     """What the signature of a correct model reaches on this drive.
 
-    The model with ``effects`` (the candidate; None: the nominal model) as recorded in
-    ``sim`` (road phase ``seed + 1``, as the signature's) against ``n`` surrogate
-    measurements the same model makes on other road phases (``seed + 2`` ...; same fitted
-    road statistics, speed and sensor noise): the mean z^2 of the single-input and of the
-    two-input axle-to-body transmissibility (:func:`diagnosis.verdict.transmissibility_chi2`).
-    If the candidate were the truck, its signature against the measurement would scatter
-    like this.  About 1 for an estimator the road does not enter; the single-input ratio
-    of a four-axle truck is not such an estimator (docs/diagnosis.md), and the verdict holds
-    a candidate to what it meets against itself (:func:`diagnosis.verdict.signature_threshold`).
-
-    ``records``: the n surrogate records' noise-free channels when already simulated
-    (``model.run(effects, 0, T, seed + 2 + j)``), else they are simulated here.
+    ``sim``: the candidate's record on the signature's road phase; ``records``: the same
+    model's noise-free channels on other road phases ``seeds`` (same fitted road statistics
+    and speed), which become surrogate measurements with their own sensor noise.  Returns the
+    mean z^2 of each surrogate against ``sim``, single-input and two-input axle-to-body
+    transmissibility (:func:`diagnosis.verdict.transmissibility_chi2`): if the candidate were
+    the truck, its signature against the measurement would scatter like this.  About 1 for
+    an estimator the road does not enter; the single-input ratio of a four-axle truck is not
+    such an estimator (docs/diagnosis.md; :func:`diagnosis.verdict.signature_threshold`).
 
     Returns
     -------
     dict
-        ``{"single_input": [n values], "two_input": [n values or none]}``.
+        ``{"single_input": [one per record], "two_input": [one per record, or none]}``.
     """
     from diagnosis.compare import transmissibility
     from diagnosis.verdict import transmissibility_chi2
 
-    T = sig.time.size / sig.fs
     out = {"single_input": [], "two_input": []}
-    for j in range(int(n) if records is None else len(records)):
-        sd = seed + 2 + j
-        rec = model.run(effects or {}, 0.0, T, sd) if records is None else records[j]
+    for rec, sd in zip(records, seeds):
         surr = Signals(sig.time, model.add_noise(rec, sd), dict(sig.units), sig.speed,
                        {"model": f"road phase {sd}"})
         out["single_input"].append(transmissibility_chi2(transmissibility(surr, sim))[0])
@@ -1251,7 +1243,7 @@ def _winner_signature(model: TruckModel, sig: Signals, sim: Signals, tr, tr2, ra
         runs = [model.run(eff, 0.0, T, sd) for sd in seeds]
     simw = Signals(sig.time, model.add_noise(runs[0], seeds[0]), dict(sig.units), sig.speed,
                    {"model": ranking.winner.effect})
-    null = signature_null(model, sig, simw, seed, effects=eff, records=runs[1:])
+    null = signature_null(model, sig, simw, runs[1:], seeds[1:])
     sig_w = signature(ranking.winner.effect, tr, transmissibility(sig, simw), null=null["single_input"])
     sig_w2 = None
     tr2w = two_input_or_none(sig, simw) if tr2 is not None else None
@@ -1372,7 +1364,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                     for c, h, sd in splits]
         ranking = rankings[0] if folds == 1 else combine_folds(rankings)
         timing["ranking_s"] = _time.perf_counter() - t
-        # the winner's road-independent signature: its axle-to-body transmissibility on the
+        # the winner's signature: its axle-to-body transmissibility on the
         # nominal model's road and seed, against the measurement (diagnosis.verdict); both the
         # single-input ratio (``signature``) and the two-input estimate (``signature_two_input``,
         # where both sides are measured), each with what the winner reaches against itself;
