@@ -68,11 +68,13 @@ def test_lambda_changes_lateral_against_longitudinal_spectrum():
     """eq (5) predicts lateral/longitudinal PSD ratio lam^(1-w) at equal n: 1 (lam = 1),
     0.25 (lam = 4), 2 (lam = 0.5).  The lateral estimate uses 41-point lines (4 m, Hann),
     with 0.24 cycles/m resolution and leakage from the steeper low band, so only a factor 2
-    around the predicted ratios is claimed; the effect tested is 4x and 2x."""
+    around the predicted ratios is claimed; the effect tested is 4x and 2x.  For lam = 0.5 the
+    lower end is raised to 1.4: a factor 2 below the predicted 2 is 1.0, the value with no
+    effect at all, which a lam ignored by the synthesis could reach (measured 2.03, seed 5)."""
     r1, r4, r05 = (_lateral_over_longitudinal(lam) for lam in (1.0, 4.0, 0.5))
     assert 0.5 < r1 < 2.0
     assert 0.125 < r4 / r1 < 0.5
-    assert 1.0 < r05 / r1 < 4.0
+    assert 1.4 < r05 / r1 < 4.0
 
 
 def test_fast_grid_path_equals_exact_sum():
