@@ -60,24 +60,60 @@ def profile_rows(case: dict, min_s: float = 3.0) -> list:
     return rows
 
 
-def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool = False) -> list:
+def redecided_loops(diag_root: Path) -> dict:
+    """Per seed, the closed loop as today's verdict rules would run it: ``{seed: (verdict,
+    corrected)}`` from the saved diagnoses of a blind folder (``diagnosis.blind.rescore``;
+    corrected as ``diagnosis.closed_loop.effects_from_diagnosis`` decides)."""
+    from diagnosis.closed_loop import effects_from_diagnosis
+    from diagnosis.verdict import decide
+
+    out = {}
+    for r in json.loads((diag_root / "blind.json").read_text())["results"]:
+        summ = json.loads((diag_root / f"case{r['case']:03d}-summary.json").read_text())
+        d = decide(summ)
+        summ = dict(summ, verdict=d["verdict"], verdict_confidence=d["confidence"], verdict_detail=d)
+        out[int(r["seed"])] = (d["verdict"], effects_from_diagnosis(summ)[0] is not None)
+    return out
+
+
+def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool = False,
+         loops: dict | None = None) -> list:
     """Rows of segments >= ``min_s`` (true segments; with ``profile`` the measured-road drives'
     fitted segments against the profile instead, :func:`profile_rows`; with ``open_loop`` the
     nominal inversion's rows where a closed-loop run (``bench_inverse.py --effects-auto``)
-    corrected the drive, i.e. the same drives inverted without the loop)."""
+    corrected the drive, i.e. the same drives inverted without the loop).
+
+    Each row gets ``model_form`` (``inverse.uncertainty.MODEL_FORMS``) as
+    ``diagnosis.closed_loop.model_form`` decides it from the record's ``closed_loop``
+    (records without one: "open"). ``loops`` (``{seed: (verdict, corrected)}``,
+    :func:`redecided_loops`) replaces the recorded verdicts: a drive corrected then and not
+    now is scored on its nominal rows."""
+    from diagnosis.closed_loop import model_form
+
     rows = []
     # a set re-scored after a change of the scoring (bench_inverse.py --rescore) is read re-scored
     res = root / "results-rescored.jsonl"
     for line in (res if res.is_file() else root / "results.jsonl").read_text().splitlines():
         case = json.loads(line)
+        loop = case.get("closed_loop")
+        nominal_rows = open_loop and bool(case.get("nominal"))
+        if loop and loops is not None and case["seed"] in loops:
+            verdict, corrected = loops[case["seed"]]
+            if corrected and not loop.get("corrected"):
+                raise SystemExit(f"{root}: seed {case['seed']} would be corrected now and has no corrected record")
+            nominal_rows = nominal_rows or (loop.get("corrected") and not corrected)
+            loop = {"verdict": verdict, "corrected": corrected}
+        form = "open" if not loop or (nominal_rows and loop.get("corrected")) else \
+            model_form(loop.get("verdict"), bool(loop.get("corrected")))
         if profile:
             segs = profile_rows(case, min_s)
         else:
-            segs = case.get("nominal") if open_loop and case.get("nominal") else case.get("segments", [])
+            segs = case.get("nominal") if nominal_rows and case.get("nominal") else case.get("segments", [])
         for r in segs:
             if r["duration_s"] >= min_s and "lnGq_err" in r:
                 r["seed"] = case["seed"]
                 r["scenario"] = case.get("scenario", "")
+                r["model_form"] = form
                 # records made before the pipeline reported honest sd hold the Laplace ones
                 r.setdefault("sd_laplace", {"ln_Gq_n0": r["sd_ln_Gq_n0"], "w": r["sd_w"]})
                 r.setdefault("sd_ln_G_n_best_laplace", r.get("sd_ln_G_n_best"))
@@ -104,8 +140,10 @@ def calibrate(rows: list) -> dict:
 
 
 def reported_sd(r, q, sd_lap, const) -> float:
-    """inverse.uncertainty's formula with the constants in ``const``."""
-    return U.reported_sd(sd_lap, misfit(r), q, kappa=const["KAPPA"], beta=const["BETA"], r_ref=const["R_REF"])
+    """inverse.uncertainty's formula with the constants in ``const`` (BETA_DIAGNOSED for a row
+    whose model form is "diagnosed")."""
+    beta = const["BETA_DIAGNOSED"] if r.get("model_form") == "diagnosed" else const["BETA"]
+    return U.reported_sd(sd_lap, misfit(r), q, kappa=const["KAPPA"], beta=beta, r_ref=const["R_REF"])
 
 
 def choose_beta(rows: list, const: dict, grid=(0.0, 0.01, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5)) -> dict:
@@ -119,6 +157,20 @@ def choose_beta(rows: list, const: dict, grid=(0.0, 0.01, 0.03, 0.05, 0.1, 0.2, 
                 best = b
                 break
         out[q] = best
+    return out
+
+
+def choose_beta_diagnosed(rows: list, const: dict, grid=(0.0, 0.01, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5)) -> dict:
+    """Per quantity, the smallest grid value of BETA_DIAGNOSED at which 90 % of the intervals
+    of ``rows`` (their "diagnosed" rows) hold; the last grid value if none does."""
+    rows = [r for r in rows if r.get("model_form") == "diagnosed"]
+    out = {}
+    for q in QUANTITIES:
+        out[q] = grid[-1]
+        for b in grid:
+            if coverage(rows, {**const, "BETA_DIAGNOSED": {**const["BETA_DIAGNOSED"], q: b}})[q][0] >= 0.90 - 1e-9:
+                out[q] = b
+                break
     return out
 
 
@@ -165,11 +217,24 @@ def main(argv=None) -> int:
                     help="print each set's coverage for a grid of the level terms' BETA "
                          "(ln Gq(n0) and ln G(n_best) alike; w keeps its constant): does one value "
                          "serve every set?")
+    ap.add_argument("--verdicts", action="append", default=[], metavar="NAME=DIAG_ROOT",
+                    help="re-decide the closed-loop verdicts of set NAME with today's rules from the saved "
+                         "diagnoses of a blind folder (results/diagnosis_blind/...): which drives would be "
+                         "corrected and which model-form term their intervals carry")
+    ap.add_argument("--beta-diagnosed-from", default=None, metavar="NAME[,NAME...]",
+                    help="choose BETA_DIAGNOSED (the model-form term of drives the diagnosis checked) on "
+                         "these closed-loop sets pooled: per quantity the smallest grid value at which 90 %% "
+                         "of their diagnosed segments' intervals hold; with two or more sets, each set "
+                         "alone is also used to calibrate and the others scored out of sample")
     a = ap.parse_args(argv)
+    loops = {}
+    for item in a.verdicts:
+        name, _, droot = item.partition("=")
+        loops[name] = redecided_loops(Path(droot))
     sets = {}
     for item in a.sets:
         name, _, root = item.partition("=")
-        sets[name] = load(Path(root), a.min_s)
+        sets[name] = load(Path(root), a.min_s, loops=loops.get(name))
     extra = {}
     for name in list(sets):
         root = Path(dict(i.partition("=")[::2] for i in a.sets)[name])
@@ -179,9 +244,9 @@ def main(argv=None) -> int:
                 for sc in scens:
                     extra[f"{name}/{sc}"] = [r for r in sets[name] if r["scenario"] == sc]
         if a.open_loop and any(json.loads(li).get("nominal") for li in (root / "results.jsonl").read_text().splitlines()):
-            extra[f"{name}/open-loop"] = load(root, a.min_s, open_loop=True)
+            extra[f"{name}/open-loop"] = load(root, a.min_s, open_loop=True, loops=loops.get(name))
         if a.profile:
-            pr = load(root, a.min_s, profile=True)
+            pr = load(root, a.min_s, profile=True, loops=loops.get(name))
             if pr:
                 extra[f"{name}/profile"] = pr
     # the constants of the fit that made the records (each record's fit_model; older records
@@ -203,9 +268,23 @@ def main(argv=None) -> int:
         if a.beta_from:
             const["BETA"] = choose_beta(sets[a.beta_from], const)
             print(f"BETA chosen on '{a.beta_from}': " + ", ".join(f"{k} {v:g}" for k, v in const["BETA"].items()))
+        const["BETA_DIAGNOSED"] = dict(const["BETA"])
     else:
         print(f"constants of inverse/uncertainty.py for the {fit_model} fit: R_REF {const['R_REF']}, R_GATE {const['R_GATE']}, "
-              f"KAPPA {const['KAPPA']}, BETA {const['BETA']}")
+              f"KAPPA {const['KAPPA']}, BETA {const['BETA']}, BETA_DIAGNOSED {const['BETA_DIAGNOSED']}")
+    cross = []
+    if a.beta_diagnosed_from:
+        names = a.beta_diagnosed_from.split(",")
+        const["BETA_DIAGNOSED"] = choose_beta_diagnosed([r for n in names for r in sets[n]], const)
+        print(f"BETA_DIAGNOSED chosen on {' + '.join(names)} pooled: "
+              + ", ".join(f"{k} {v:g}" for k, v in const["BETA_DIAGNOSED"].items()))
+        for n in names if len(names) > 1 else []:
+            bd = choose_beta_diagnosed(sets[n], const)
+            for m in names:
+                if m != n:
+                    cross.append((f"{m}, BETA_DIAGNOSED from {n} alone ("
+                                  + ", ".join(f"{v:g}" for v in bd.values()) + ")",
+                                  coverage(sets[m], {**const, "BETA_DIAGNOSED": bd})))
     print("\n| set | segments >= %g s | flagged poor | 90 %% cover ln Gq(n0) | w | ln G(n_best) | "
           "noise-only sd: ln Gq(n0) | w | ln G(n_best) |" % a.min_s)
     print("|---|---|---|---|---|---|---|---|---|")
@@ -217,6 +296,11 @@ def main(argv=None) -> int:
     scored = {**sets, **extra}
     for name, rows in scored.items():
         line(name, coverage(rows, const))
+    for name, c in cross:
+        line(name, c)
+    print("\nmodel-form term per set (segments): " + "; ".join(
+        f"{name} {sum(r.get('model_form') == 'diagnosed' for r in rows)} diagnosed / "
+        f"{sum(r.get('model_form') != 'diagnosed' for r in rows)} open" for name, rows in scored.items()))
     print("\n| set | segments >= %g s | G(1 cycle/m) within 20 %% | class right |" % a.min_s)
     print("|---|---|---|---|")
     for name, rows in scored.items():
@@ -226,7 +310,7 @@ def main(argv=None) -> int:
         print("\n| BETA (ln Gq(n0), ln G(n_best)) | " + " | ".join(scored) + " |")
         print("|---|" + "---|" * len(scored))
         for b in (0.0, 0.03, 0.1, 0.2, 0.3, 0.5, 1.0):
-            c = {**const, "BETA": {**const["BETA"], "ln_Gq_n0": b, "ln_G_n_best": b}}
+            c = {**const, **{k: {**const[k], "ln_Gq_n0": b, "ln_G_n_best": b} for k in ("BETA", "BETA_DIAGNOSED")}}
             cells = []
             for rows in scored.values():
                 cv = coverage(rows, c)

@@ -72,6 +72,17 @@ def effects_from_diagnosis(summary: dict, action: str = "inverted") -> tuple[dic
     return params, f"the diagnosis named {verdict} ({how}); {action} with {text}"
 
 
+def model_form(verdict: str | None, corrected: bool) -> str:
+    """The model-form state of a closed loop's reported inversion
+    (:data:`inverse.uncertainty.MODEL_FORMS`): "diagnosed" where the diagnosis found no gap
+    beyond noise (``none``) or named an effect the inversion then carries (``corrected``);
+    "open" where a vehicle difference is left unaccounted for: a gap no library effect
+    explains (``unexplained``; on the measured road profile the smaller term covered
+    ln G(n_best) in 6 of 12 segments, docs/inverse.md section 11) or an effect named but not
+    singled out."""
+    return "diagnosed" if corrected or verdict == "none" else "open"
+
+
 def _start(out, force: bool) -> tuple[Path, Path]:
     """A closed loop's output folder (refused if non-empty unless ``force``) and the
     temporary work folder beside it that is renamed into place at the end."""
@@ -162,24 +173,27 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
         progress(f"closed loop: {reason}")
         progress("closed loop: nominal inversion ...")
         nominal = run_inversion(dataset, work / "nominal", workers=workers, seed=seed, quick=quick,
-                                argv=argv, **inversion)
+                                argv=argv, model_form=model_form(dsum.get("verdict"), False), **inversion)
         if effects:
             progress("closed loop: corrected inversion ...")
             chosen = run_inversion(dataset, work / "corrected", workers=workers, seed=seed, quick=quick,
-                                   effects=effects, argv=argv, **inversion)
+                                   effects=effects, argv=argv, model_form=model_form(dsum.get("verdict"), True),
+                                   **inversion)
             main = work / "corrected"
             (work / "nominal").rename(main / "nominal")
             fq = chosen.get("fit_quality", {})
             if fq.get("status") == "poor":   # the named effect did not make the model explain it
                 fq["message"] = still_poor_message(fq, effects)
                 from inverse.report import table1, table1_note
-                write_table(table1(chosen["segments"]), main / "tables" / "table1", note=table1_note(fq, segments=chosen["segments"]))
+                write_table(table1(chosen["segments"]), main / "tables" / "table1",
+                            note=table1_note(fq, segments=chosen["segments"], model_form="diagnosed"))
         else:
             chosen, main = nominal, work / "nominal"
         (work / "diagnose").rename(main / "diagnose")
         chosen["closed_loop"] = {
             "verdict": dsum.get("verdict"), "confidence": dsum.get("verdict_confidence"),
             "effects": effects or {}, "corrected": bool(effects), "reason": reason,
+            "model_form": chosen.get("fit", {}).get("model_form"),
             "diagnosis": "diagnose/summary.json",
             "nominal_segments": nominal["segments"] if effects else None,
             "nominal_fit_quality": nominal.get("fit_quality") if effects else None}

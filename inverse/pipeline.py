@@ -77,6 +77,10 @@ class InversionConfig:
         Most simulate-and-refit rounds of the "linear" fit (0: linear model alone);
         at least ``inverse.linear_features.CORRECTIONS_NONLINEAR`` (4) when the
         simulator has nonlinear effects the linear model leaves out.
+    model_form : {"open", "diagnosed"}
+        Which model-form term the reported uncertainty carries
+        (:data:`inverse.uncertainty.MODEL_FORMS`): "diagnosed" where the diagnosis found no
+        gap on this drive or named the effect the fit carries (``diagnosis.closed_loop``).
     """
 
     k: int | None = None
@@ -94,6 +98,7 @@ class InversionConfig:
     noise_psd: dict | None = None
     fit_model: str = "simulation"
     linear_corrections: int = 2
+    model_form: str = "open"
 
 
 #: a fitted parameter this close to a bound is reported as on it (w [-]; ln Gq_n0 [-])
@@ -169,7 +174,8 @@ class Inversion:
         for k, s in enumerate(self.fit.segments):
             d = s.as_dict()
             fm = self.config.fit_model
-            sd = honest_sd(d["sd"], d.get("sd_ln_G_n_best"), d["objective"], d["n_features"], fit_model=fm)
+            sd = honest_sd(d["sd"], d.get("sd_ln_G_n_best"), d["objective"], d["n_features"], fit_model=fm,
+                           model_form=self.config.model_form)
             iv = {"Gq_n0": interval90(d["Gq_n0"], sd["ln_Gq_n0"], log=True),
                   "w": interval90(d["w"], sd["w"], log=False)}
             best = {}
@@ -196,7 +202,7 @@ class Inversion:
         rounds = [h for h in self.fit.history if h.get("kind") == "trust_region" and "move" in h]
         hybrid = {"corrections": len(rounds), "last_move": rounds[-1]["move"]} if rounds else {}
         return {"segments": self.segments(),
-                "fit": {"model": self.config.fit_model, **hybrid, "n_sims": self.fit.n_sims, "wall_s": self.fit.wall_s,
+                "fit": {"model": self.config.fit_model, "model_form": self.config.model_form, **hybrid, "n_sims": self.fit.n_sims, "wall_s": self.fit.wall_s,
                         "iterations": sum(h.get("kind") == "trust_region" for h in self.fit.history[1:]),
                         "polished": any(h.get("kind") == "polish" for h in self.fit.history),
                         "objective": float(self.fit.history[-1]["objective"]),
@@ -246,6 +252,9 @@ def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
     """
     if config.fit_model not in ("simulation", "linear"):
         raise EroadInputError(f"fit_model must be 'simulation' or 'linear', got {config.fit_model!r}")
+    from inverse.uncertainty import MODEL_FORMS
+    if config.model_form not in MODEL_FORMS:
+        raise EroadInputError(f"model_form must be one of {', '.join(MODEL_FORMS)}, got {config.model_form!r}")
     t = np.asarray(time, dtype=float)
     if segment_channels is None:
         segment_channels = sorted(c for c in channels if c.startswith("susp_disp_3")) or \

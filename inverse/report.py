@@ -76,10 +76,24 @@ ROAD_MODEL_NOTE = (
     "studies use the two slopes where road_model says two_slope, else the one-slope fit.")
 
 
-def table1_note(fit_quality: dict | None = None, road_model: bool = True, segments=None) -> str:
+#: the sentence of Table 1's note per model-form state (:data:`inverse.uncertainty.MODEL_FORMS`)
+MODEL_FORM_NOTE = {
+    "open": ("Model-form term: 'open' -- a vehicle difference may be unaccounted for (the model was not "
+             "checked against this drive, or the diagnosis found a gap no library effect explains), so "
+             "the intervals allow for it hiding in the road level (`eroad invert --effects auto` "
+             "diagnoses first)."),
+    "diagnosed": ("Model-form term: 'diagnosed' -- the diagnosis found no gap beyond noise, or named the "
+                  "effect this fit carries, so the intervals carry the smaller term calibrated on "
+                  "diagnosed drives."),
+}
+
+
+def table1_note(fit_quality: dict | None = None, road_model: bool = True, segments=None,
+                model_form: str | None = None) -> str:
     """The paragraph under Table 1: what the uncertainty columns mean, and the gate's verdict;
     with ``road_model`` (default: every run reports it) also what the road-model columns
-    mean (:data:`ROAD_MODEL_NOTE`)."""
+    mean (:data:`ROAD_MODEL_NOTE`); with ``model_form`` which model-form term the intervals
+    carry (:data:`MODEL_FORM_NOTE`)."""
     from inverse.uncertainty import R_GATE
 
     gate = next((r["fit_quality"]["gate"] for r in segments or [] if "gate" in r.get("fit_quality", {})), R_GATE)
@@ -87,6 +101,8 @@ def table1_note(fit_quality: dict | None = None, road_model: bool = True, segmen
             "calibrated on blind drives (docs/inverse.md, section 11). 'fit' is the fit-quality gate: "
             f"'poor' where the misfit per feature exceeds {gate:g}, i.e. the model does not explain "
             "the segment's data and its numbers are not a clean result.")
+    if model_form is not None:
+        note += " " + MODEL_FORM_NOTE[model_form]
     if fit_quality and fit_quality.get("status") == "poor":
         note = f"**POOR FIT**: {fit_quality['message']}.\n\n" + note
     if road_model:

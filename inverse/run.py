@@ -94,7 +94,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                   force: bool = False, candidates=None, max_iter=None, effects=None, chassis: str = "rigid",
                   channels="axle3", argv=None, polish: bool = True, noise_sd=None,
                   fit_model: str = "linear", selection: str = "linear", bar=None,
-                  road_model: str = "auto") -> dict:
+                  road_model: str = "auto", model_form: str = "open") -> dict:
     """Invert a dataset into the run folder ``out`` (see the module docstring).
 
     Parameters
@@ -147,6 +147,10 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     bar : tqdm.tqdm, optional
         Progress bar (:func:`eroad.progress.progress_bar`), advanced per fit
         iteration and per candidate realisation.
+    model_form : {"open", "diagnosed"}
+        The model-form term of the reported intervals (:data:`inverse.uncertainty.MODEL_FORMS`):
+        "open" unless the diagnosis found no gap on this drive or named the effect this fit
+        carries (``diagnosis.closed_loop`` sets it); recorded in ``summary["fit"]["model_form"]``.
 
     Returns
     -------
@@ -192,7 +196,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     fs = 1.0 / float(np.median(np.diff(time)))
     noise_psd = noise_psd_from_sd(noise_sd, list(drive.channel_names), fs) if noise_sd else None
     icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd,
-                           fit_model=fit_model)
+                           fit_model=fit_model, model_form=model_form)
     make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans))
     predict = TruckPredictRms(drive.vehicle, ("susp_disp_3L", "susp_disp_3R"), chassis=chassis, effects=effects)
 
@@ -315,7 +319,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             }
             summary["lateral"] = lateral
             write_table(table1(segs), tmp / "tables" / "table1",
-                        note=table1_note(summary["fit_quality"], segments=summary["segments"]) + "\n\n" + note_line(summary["lateral"]))
+                        note=table1_note(summary["fit_quality"], segments=summary["segments"], model_form=model_form) + "\n\n" + note_line(summary["lateral"]))
             basis = ""
             if sel["method"] == "linear":
                 basis = (f" Realisations: {sel['n_simulated']} of {len(seeds)} simulated in time, the others the "
@@ -337,7 +341,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                    "noise_sd": dict(noise_sd or {}), "polish": bool(polish),
                    "workers": workers, "seed": seed, "quick": quick, "candidates": n_cand, "max_iter": iters,
                    "chassis": chassis, "channels": list(chans), "effects": json.dumps(effects or {}),
-                   "fit_model": fit_model, "selection": selection,
+                   "fit_model": fit_model, "selection": selection, "model_form": model_form,
                    "simulator": {"dx_m": SIM_DX, "nmax_cap_cpm": nmax_cap(SIM_DX)},
                    "bounds": {k: list(getattr(bounds, k)) for k in ("Gq_n0", "w", "nmin", "nmax")}}
             (tmp / "config.toml").write_text(tomli_w.dumps(cfg))

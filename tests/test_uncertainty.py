@@ -90,3 +90,58 @@ def test_each_fit_model_has_its_own_calibration():
     assert sd["ln_G_n_best"] == pytest.approx(lin["KAPPA"]["ln_G_n_best"] * 0.04)
     with pytest.raises(ValueError, match="no uncertainty calibration"):
         U.calibration("quarter")
+
+
+def test_a_diagnosed_drive_carries_the_smaller_model_form_term():
+    """Above the reference misfit the model-form variance is BETA_DIAGNOSED where the diagnosis
+    found no gap or the fit carries the named effect, BETA where a vehicle difference may be
+    left ('open', the default); at or below it neither term adds anything; an unknown state is
+    refused. The diagnosed constants are smaller for every quantity (the term exists because
+    an unchecked model can hide a vehicle difference in the road level)."""
+    lin = U.calibration("linear")
+    lap = {"ln_Gq_n0": 0.1, "w": 0.05}
+    hi = dict(objective=4 * lin["R_REF"] * 10, n_features=10, fit_model="linear")
+    op = U.honest_sd(lap, 0.04, **hi)
+    dg = U.honest_sd(lap, 0.04, model_form="diagnosed", **hi)
+    for q, v in (("ln_Gq_n0", 0.1), ("w", 0.05), ("ln_G_n_best", 0.04)):
+        assert lin["BETA_DIAGNOSED"][q] < lin["BETA"][q]
+        assert dg[q] == pytest.approx(math.sqrt((2 * lin["KAPPA"][q] * v) ** 2 + 3 * lin["BETA_DIAGNOSED"][q]))
+        assert op[q] == pytest.approx(math.sqrt((2 * lin["KAPPA"][q] * v) ** 2 + 3 * lin["BETA"][q]))
+    lo = dict(objective=0.5 * lin["R_REF"] * 10, n_features=10, fit_model="linear")
+    assert U.honest_sd(lap, 0.04, model_form="diagnosed", **lo) == U.honest_sd(lap, 0.04, **lo)
+    with pytest.raises(ValueError, match="model_form"):
+        U.honest_sd(lap, 0.04, model_form="closed", **lo)
+    assert "'diagnosed'" in table1_note({"status": "clean"}, model_form="diagnosed")
+    assert "'open'" in table1_note({"status": "clean"}, model_form="open")
+
+
+@pytest.mark.parametrize("verdict, corrected, form", [
+    ("none", False, "diagnosed"), ("leaf_friction", True, "diagnosed"),
+    ("unexplained", False, "open"), ("leaf_friction", False, "open")])
+def test_closed_loop_model_form(verdict, corrected, form):
+    """Only a drive the diagnosis found no gap in, or one inverted with the effect it named,
+    gets the smaller term; an unexplained gap or a name not acted on keeps the open one."""
+    from diagnosis.closed_loop import model_form
+    assert model_form(verdict, corrected) == form
+
+
+def test_beta_diagnosed_rule_picks_the_smallest_value_that_covers_90_percent():
+    """benchmarks/calibrate_uncertainty.py's rule on rows with a known error spread: errors of
+    sd 0.3 in ln units, Laplace sd 0.01 and misfit 2 R_REF, so the reported sd is about
+    sqrt(BETA); 90 % coverage needs 1.645 sqrt(BETA) >= the 90 % quantile of |error| (0.49),
+    BETA >= 0.089: the rule must pick 0.1 from its grid, not 0.05 (78 %) and not more. Open
+    rows are not used."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    import calibrate_uncertainty as C
+
+    rng = np.random.default_rng(3)
+    const = {k: (dict(v) if isinstance(v, dict) else v) for k, v in U.calibration("linear").items()}
+    e = 0.3 * rng.standard_normal(4000)
+    rows = [{"objective": 2 * const["R_REF"] * 10, "n_features": 10, "model_form": "diagnosed",
+             "lnGq_err": x, "w_err": x, "lnG_n_best_err": x, "sd_laplace": {"ln_Gq_n0": 0.01, "w": 0.01},
+             "sd_ln_G_n_best_laplace": 0.01} for x in e]
+    rows += [dict(r, model_form="open", lnGq_err=10.0, w_err=10.0, lnG_n_best_err=10.0) for r in rows[:500]]
+    assert C.choose_beta_diagnosed(rows, const) == {"ln_Gq_n0": 0.1, "w": 0.1, "ln_G_n_best": 0.1}
