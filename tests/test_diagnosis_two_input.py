@@ -177,7 +177,9 @@ def _summary(sig1, sig2=None):
                      "gap_present": True},
          "ranking_decision": {"verdict": "tyre_enveloping", "confidence": "clear", "reason": "r"},
          "ranking": [{"effect": "tyre_enveloping", "accepted": True, "heldout_gap_before": 3.0,
-                      "heldout_gap_after": 1.1, "parameters": {"tyre_enveloping": {"length": 0.3}}}],
+                      # 1.5: 5 sd above a correct model's gap, so the signature decides (not the
+                      # gap alone, diagnosis.verdict.FULL_GAP_Z)
+                      "heldout_gap_after": 1.5, "parameters": {"tyre_enveloping": {"length": 0.3}}}],
          "meta": {"search_ranges": {"tyre_enveloping": {"length": [0.1, 1.0, False]}}},
          "signature": {"model": "tyre_enveloping", "chi2_nominal": sig1[0], "chi2_model": sig1[1],
                        "n_cells": 100, "pairs_off": []}}

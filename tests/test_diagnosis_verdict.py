@@ -60,7 +60,8 @@ def test_too_small_a_share_is_unexplained():
 
 
 def test_disagreeing_signature_is_unexplained():
-    d = decide(_summary(chi2=(3.0, SIGNATURE_CHI2_MAX + 1.0)))
+    # after 0.6: the gap left is 4 sd above a correct model's, so the signature decides
+    d = decide(_summary(after=0.6, chi2=(3.0, SIGNATURE_CHI2_MAX + 1.0)))
     assert d["verdict"] == "unexplained" and d["signature_agrees"] is False
     assert "transmissibility" in d["reason"]
     # a model no worse than a nominal that already agrees is not held against the effect
@@ -101,8 +102,9 @@ def test_partial_signature_names_the_effect_but_not_clearly():
     d = decide(_summary(chi2=(9.0, 5.0)))
     assert d["verdict"] == "leaf_friction" and d["confidence"] == "ambiguous"
     assert "remains" in d["reason"]
-    # an effect that leaves an off transmissibility as it was does not agree
-    assert decide(_summary(chi2=(9.0, 9.0)))["verdict"] == "unexplained"
+    # an effect that leaves an off transmissibility as it was does not agree (with a gap left
+    # beyond a correct model's; the whole gap taken: test_whole_gap_is_named_on_the_gap_alone)
+    assert decide(_summary(after=0.6, chi2=(9.0, 9.0)))["verdict"] == "unexplained"
 
 
 def test_signature_is_held_to_what_a_correct_model_reaches_on_the_drive():
@@ -110,7 +112,7 @@ def test_signature_is_held_to_what_a_correct_model_reaches_on_the_drive():
     transmissibility as the nominal model's; where the candidate model scores 2.4-3.6 against
     its OWN records on other road phases, 3.1 is what it would reach if it were right, not a
     disagreement.  Above that level the test is as before; without surrogate values too."""
-    s = _summary(chi2=(3.1, 3.1))
+    s = _summary(after=0.6, chi2=(3.1, 3.1))
     assert decide(s, signature_null=True)["verdict"] == "unexplained"   # no surrogate values: 2 asked
     null = [2.4, 3.6, 3.0]
     s["signature"]["chi2_correct_model"] = null + [None]
@@ -170,3 +172,29 @@ def test_a_name_without_a_gap_beyond_noise_is_never_clear():
     assert d["verdict"] == "leaf_friction" and d["confidence"] == "ambiguous"
     assert d["explained_share"] == pytest.approx(3.0)
     assert "within a correct model's scatter" in d["reason"] and not d["identified"]
+
+
+def test_whole_gap_is_named_on_the_gap_alone_never_clear():
+    """An effect that takes the whole gap (share >= FULL_SHARE_MIN, the gap left within
+    FULL_GAP_Z sd of a correct model's) is named although its transmissibility stays off as
+    the nominal model's (an effect acting on axle and body alike cannot move it): confidence
+    'ambiguous', not identified (no correction), and the reason says so. A gap left beyond a
+    correct model's, a share below FULL_SHARE_MIN, a ranking with a close rival, or no gap
+    beyond noise keep 'unexplained'."""
+    from diagnosis.verdict import FULL_GAP_Z, FULL_SHARE_MIN
+
+    off = (3.0, 3.0)
+    d = decide(_summary(after=0.45, chi2=off))     # share 0.92, gap left 1 sd above a correct model's
+    assert d["verdict"] == "leaf_friction" and d["confidence"] == "ambiguous"
+    assert d["identified"] is False and d["signature_agrees"] is False
+    assert "gap alone" in d["reason"] and "no correction" in d["reason"]
+    from diagnosis.closed_loop import effects_from_diagnosis
+    assert effects_from_diagnosis({**_summary(after=0.45, chi2=off), "verdict": d["verdict"],
+                                   "verdict_confidence": d["confidence"], "verdict_detail": d})[0] is None
+    after_z = 0.4 + (FULL_GAP_Z + 0.5) * 0.05           # gap left 2.5 sd above
+    assert decide(_summary(after=after_z, chi2=off))["verdict"] == "unexplained"
+    # share just below FULL_SHARE_MIN with a wide correct-model scatter (so only the share fails)
+    after_s = 1.0 - (FULL_SHARE_MIN - 0.02) * 0.6
+    assert decide(_summary(after=after_s, null_sd=1.0, chi2=off))["verdict"] == "unexplained"
+    assert decide(_summary(after=0.45, chi2=off, rconf="ambiguous"))["verdict"] == "unexplained"
+    assert decide(_summary(after=0.45, chi2=off, gap_present=False))["verdict"] == "unexplained"
