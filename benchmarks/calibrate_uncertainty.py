@@ -62,8 +62,9 @@ def profile_rows(case: dict, min_s: float = 3.0) -> list:
 
 def redecided_loops(diag_root: Path) -> dict:
     """Per seed, the closed loop as today's verdict rules would run it: ``{seed: (verdict,
-    corrected)}`` from the saved diagnoses of a blind folder (``diagnosis.blind.rescore``;
-    corrected as ``diagnosis.closed_loop.effects_from_diagnosis`` decides)."""
+    corrected)}`` from the saved diagnoses of a blind folder (``blind.json`` and
+    ``caseNNN-summary.json``, re-decided by ``diagnosis.verdict.decide``; corrected as
+    ``diagnosis.closed_loop.effects_from_diagnosis`` decides)."""
     from diagnosis.closed_loop import effects_from_diagnosis
     from diagnosis.verdict import decide
 
@@ -87,7 +88,8 @@ def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool 
     ``diagnosis.closed_loop.model_form`` decides it from the record's ``closed_loop``
     (records without one: "open"). ``loops`` (``{seed: (verdict, corrected)}``,
     :func:`redecided_loops`) replaces the recorded verdicts: a drive corrected then and not
-    now is scored on its nominal rows."""
+    now is scored on its nominal rows (with ``profile``, left out: the records keep the
+    profile rows of the corrected inversion only)."""
     from diagnosis.closed_loop import model_form
 
     rows = []
@@ -106,7 +108,8 @@ def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool 
         form = "open" if not loop or (nominal_rows and loop.get("corrected")) else \
             model_form(loop.get("verdict"), bool(loop.get("corrected")))
         if profile:
-            segs = profile_rows(case, min_s)
+            was_corrected = bool((case.get("closed_loop") or {}).get("corrected"))
+            segs = [] if nominal_rows and was_corrected else profile_rows(case, min_s)
         else:
             segs = case.get("nominal") if nominal_rows and case.get("nominal") else case.get("segments", [])
         for r in segs:

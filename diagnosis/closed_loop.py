@@ -78,7 +78,7 @@ def model_form(verdict: str | None, corrected: bool) -> str:
     beyond noise (``none``) or named an effect the inversion then carries (``corrected``);
     "open" where a vehicle difference is left unaccounted for: a gap no library effect
     explains (``unexplained``; on the measured road profile the smaller term covered
-    ln G(n_best) in 6 of 12 segments, docs/inverse.md section 11) or an effect named but not
+    ln G(n_best) in 6 of 10 fitted segments, docs/inverse.md section 11) or an effect named but not
     singled out."""
     return "diagnosed" if corrected or verdict == "none" else "open"
 

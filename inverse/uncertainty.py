@@ -97,8 +97,9 @@ Z90 = 1.6448536269514722
 # results/inverse_blind/20261124-model-form-diagnosed/. Set on the friction drives alone it
 # is the same; set on the independent truck alone, (0.2, 0.03, 0.01), it covers 94 / 92 /
 # 88 % of the friction drives' segments. (Giving ``unexplained`` the small term too would
-# cover 93 / 90 / 91 % of the independent truck's synthetic-road segments but only 92 / 75 /
-# 50 % of its 12 measured-road ones: an unexplained gap can sit in the road level.)
+# cover 93 / 90 / 91 % of the independent truck's segments but only 90 / 90 / 60 % of the
+# 10 fitted segments of its measured-road drives scored against the profile: an unexplained
+# gap can sit in the road level.)
 
 #: the model-form states of :func:`honest_sd`
 MODEL_FORMS = ("open", "diagnosed")
