@@ -52,9 +52,10 @@ def test_accepted_explaining_and_agreeing_effect_is_named():
 
 
 def test_too_small_a_share_is_unexplained():
-    # after chosen so the share is just below the threshold
+    # after chosen so the share is just below the threshold; the nominal transmissibility
+    # agrees (1.2), so no signature evidence names it either
     after = 1.0 - (SHARE_MIN - 0.05) * 0.6
-    d = decide(_summary(after=after))
+    d = decide(_summary(after=after, chi2=(1.2, 1.1)))
     assert d["verdict"] == "unexplained" and d["confidence"] == "none"
     assert d["closest"] == "leaf_friction" and "explains" in d["reason"]
 
@@ -198,3 +199,21 @@ def test_whole_gap_is_named_on_the_gap_alone_never_clear():
     assert decide(_summary(after=after_s, null_sd=1.0, chi2=off))["verdict"] == "unexplained"
     assert decide(_summary(after=0.45, chi2=off, rconf="ambiguous"))["verdict"] == "unexplained"
     assert decide(_summary(after=0.45, chi2=off, gap_present=False))["verdict"] == "unexplained"
+
+
+def test_strong_signature_names_an_effect_with_a_small_share_never_clear():
+    """An effect that explains little of the gap (a larger out-of-library difference beside
+    it) is named when it removes at least SIGNATURE_STRONG of the nominal model's
+    transmissibility excess: 'ambiguous', not identified, reason says why. Below that, or
+    with no share at all, it stays 'unexplained'."""
+    from diagnosis.verdict import SIGNATURE_STRONG
+
+    after = 1.0 - (SHARE_MIN - 0.1) * 0.6          # share 0.2, below SHARE_MIN
+    c0 = 9.0
+    strong = (c0, c0 - (SIGNATURE_STRONG + 0.1) * (c0 - 1.0))
+    d = decide(_summary(after=after, chi2=strong))
+    assert d["verdict"] == "leaf_friction" and d["confidence"] == "ambiguous" and d["identified"] is False
+    assert "named on its" in d["reason"] and "remains" in d["reason"]
+    weak = (c0, c0 - (SIGNATURE_STRONG - 0.1) * (c0 - 1.0))
+    assert decide(_summary(after=after, chi2=weak))["verdict"] == "unexplained"
+    assert decide(_summary(after=1.01, chi2=strong))["verdict"] == "unexplained"     # no share
