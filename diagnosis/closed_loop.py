@@ -186,7 +186,8 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
                 fq["message"] = still_poor_message(fq, effects)
                 from inverse.report import table1, table1_note
                 write_table(table1(chosen["segments"]), main / "tables" / "table1",
-                            note=table1_note(fq, segments=chosen["segments"], model_form="diagnosed"))
+                            note=table1_note(fq, segments=chosen["segments"],
+                                             model_form=chosen["fit"]["model_form"]))
         else:
             chosen, main = nominal, work / "nominal"
         (work / "diagnose").rename(main / "diagnose")

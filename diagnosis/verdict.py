@@ -453,8 +453,8 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
         conf = "ambiguous"
         reason += (f"; named on the gap alone: with it the held-out gap ({res['heldout_gap']:.3g}) is "
                    f"a correct model's ({res['correct_model_gap']:.3g} +- {res['correct_model_sd']:.2g}), "
-                   f"but its {what} is as far from the measurement as before (mean z^2 {c1:.2g}, nominal "
-                   f"{c0:.2g}, at most {sig_max:.2g} asked): the effect leaves no trace there, so the "
+                   f"but its {what} stays off (mean z^2 {c1:.2g}, nominal {c0:.2g}, at most "
+                   f"{sig_max:.2g} asked): the effect does not bring it nearer, so the "
                    f"signature cannot confirm it, and what keeps the transmissibility off (a difference "
                    f"beyond it, or this drive's noise) is not known -- not 'clear', no correction")
     if edges:
