@@ -37,6 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from diagnosis.pipeline import BUDGET
+
 #: truth strength per effect: (parameter, lo, hi, log, random sign of the change).
 #: Rule (docs/diagnosis.md, "Blind strengths"): the weak end is where the effect first
 #: changes some third-octave band of one channel quantity by 3 standard errors of a 30 s
@@ -68,8 +70,9 @@ ACTS = {
 }
 #: the acceptance threshold of the ranking (rank_effects' z_paired), for "detectable"
 Z_PAIRED = 3.0
-#: the ranking budget of the blind run (the whole library, no pairs)
-BLIND_SETTINGS = dict(n_seeds=4, n_null=12, grid=4, refine=3, pairs=False, folds=2)
+#: the ranking budget of the blind run: that of ``eroad diagnose`` itself (the whole
+#: library; pairs are off with two folds anyway)
+BLIND_SETTINGS = dict(BUDGET, pairs=False)
 
 
 #: truth families: the scenario a case is made from, and the effects it can carry.
