@@ -1116,6 +1116,21 @@ def delay_term(model: TruckModel):
     return DelayTerm(pairs, dist)
 
 
+#: the axle-to-body transmissibility as a third term of the gap (:func:`transmissibility_term`);
+#: experimental, off: see docs/diagnosis.md "Left" (payload)
+TRANSMISSIBILITY_TERM = False
+
+
+def transmissibility_term(model: TruckModel):
+    """The transmissibility term of the gap (:class:`diagnosis.which.TransmissibilityTerm`):
+    every wheel position with an axle and a body acceleration."""
+    from diagnosis.which import TransmissibilityTerm
+
+    pairs = [(c, "body_acc_" + c[len("axle_acc_"):]) for c in model.channels
+             if c.startswith("axle_acc_") and "body_acc_" + c[len("axle_acc_"):] in model.channels]
+    return TransmissibilityTerm(pairs) if pairs and TRANSMISSIBILITY_TERM else None
+
+
 def shape_term(model: TruckModel):
     """The amplitude-distribution term of the gap (:class:`diagnosis.which.ShapeTerm`): the
     skewness of every suspension displacement channel."""
@@ -1146,7 +1161,7 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
                   n_windows=n_windows)
     sc = _Scorer(Fit(ctx.model), Simulate(ctx.model), ctx.calib, ctx.held, seed, 1, n_seeds,
                  None, None)
-    terms = [delay_term(ctx.model), shape_term(ctx.model)] if delay else []
+    terms = [delay_term(ctx.model), shape_term(ctx.model), transmissibility_term(ctx.model)] if delay else []
     surrogates = _set_terms(sc, terms, n_null)
     sc.set_null(surrogates)
     g0, m0 = sc.heldout_scores({})
@@ -1367,7 +1382,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     try:
         rankings = [rank_effects(cands, fit, simulate, c, h, seed=sd, executor=ex,
                                  progress=progress, delay=delay_term(model),
-                                 shape=shape_term(model), **kw)
+                                 shape=shape_term(model), extra_terms=[transmissibility_term(model)],
+                                 **kw)
                     for c, h, sd in splits]
         ranking = rankings[0] if folds == 1 else combine_folds(rankings)
         timing["ranking_s"] = _time.perf_counter() - t

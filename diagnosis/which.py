@@ -689,6 +689,57 @@ class ShapeTerm(WindowTerm):
             return np.nanmean(ls - lm, axis=1)
 
 
+@dataclass
+class TransmissibilityTerm(WindowTerm):
+    """Axle-to-body transmissibility mismatch as a term of the gap (road-independent in the
+    main: a heavier body, a locked leaf spring or a stiffer mount changes how the body answers
+    the same axle motion, whatever the road).  Per window, ``log |H1|`` of every
+    ``(axle_acc, body_acc)`` pair of a wheel position in the third-octave bands between
+    ``f_lo`` and ``f_hi`` (:func:`diagnosis.compare._log_h1`, bands below the coherence
+    ``min_coherence`` left out); ``rho_j`` is the mean over pairs and bands of
+    ``ln|H_sim| - ln|H_meas|`` over the cells both sides resolve (NaN under a quarter of
+    them: the single-input coherence of a body on its own axle is low in many bands).  ``z``, ``sigma_j``
+    and the weight as :class:`WindowTerm`.  A single-input ratio still moves with the road's
+    cross-track coherence; ``sigma`` holds its road-phase scatter on the model's own road only.
+    """
+
+    pairs: list
+    f_lo: float = 2.0
+    f_hi: float = 20.0
+    min_coherence: float = 0.3
+    weight: float = 0.0
+    _meas: dict = field(default_factory=dict, repr=False)
+    _sigma: dict = field(default_factory=dict, repr=False)
+
+    SIGMA_FLOOR = 0.01
+    label = "transmissibility"
+
+    def stats(self, windows) -> np.ndarray:
+        from .bandpower import band_nperseg, third_octave_bands
+        from .compare import _log_h1
+        from .signals import as_signals
+
+        bands = third_octave_bands(self.f_lo, self.f_hi)
+        out = np.full((len(windows), len(self.pairs) * len(bands)), np.nan)
+        for j, w in enumerate(windows):
+            s = as_signals(w)
+            Ls = band_nperseg(bands, s.fs, s.time.size, bins_per_band=8, min_averages=8)
+            for k, (a, b) in enumerate(self.pairs):
+                if a in s.channels and b in s.channels:
+                    T, _V, _G = _log_h1(np.asarray(s.channels[a], float), np.asarray(s.channels[b], float),
+                                        s.fs, bands, Ls, self.min_coherence)
+                    out[j, k * len(bands):(k + 1) * len(bands)] = T
+        return out
+
+    @staticmethod
+    def _rho(ls: np.ndarray, lm: np.ndarray) -> np.ndarray:
+        d = ls - lm
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return np.array([np.nanmean(r) if np.isfinite(r).sum() >= max(4, r.size // 4) else np.nan
+                             for r in d])
+
+
 class _Scorer:
     """Evaluations shared by the search, the held-out scoring and the null (picklable)."""
 
@@ -836,7 +887,7 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                  bands: np.ndarray | None = None, z: float = 2.0, grid: int = 5, refine: int = 8,
                  executor=None, progress: Callable[[str], None] | None = None,
                  delay: DelayTerm | None = None, shape: "ShapeTerm | None" = None,
-                 z_paired: float = 3.0) -> Ranking:
+                 z_paired: float = 3.0, extra_terms: Sequence = ()) -> Ranking:
     """Rank candidate effects by held-out gap, penalised for parameters; never force a verdict.
 
     Parameters
@@ -878,6 +929,9 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     shape : ShapeTerm, optional
         Amplitude-distribution (skewness) mismatch added to every gap, weighted as the
         delay term (see :class:`ShapeTerm`).
+    extra_terms : sequence of WindowTerm
+        Further terms weighted as the delay term (e.g. :class:`TransmissibilityTerm`; None
+        entries skipped).
     z_paired : float
         Acceptance threshold in standard deviations of each candidate's paired null
         (see module docstring, steps 6-7).
@@ -901,7 +955,7 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     null_refs = [reference(s, sc.ref_held.channels, sc.ref_held.bands) for s in surrogates]
     null_band = np.array([band_gap(nominal_sims[i], null_refs[i]).value for i in range(n_null)])
     term_info = {}
-    terms = [t for t in (delay, shape) if t is not None]
+    terms = [t for t in (delay, shape, *extra_terms) if t is not None]
     if terms:
         # the terms: sigma from the nominal simulations, weight from the band gap's null
         # spread (each term's null sd = half the band gap's), then part of every gap
@@ -984,7 +1038,8 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                     z_paired=z_paired,
                     grid=grid, refine=refine, pairs=pairs, channels=sc.ref_held.channels,
                     n_calib_windows=len(sc.calib), n_heldout_windows=len(sc.heldout),
-                    delay=term_info.get("delay"), shape=term_info.get("shape"))
+                    delay=term_info.get("delay"), shape=term_info.get("shape"),
+                    **({"transmissibility": term_info["transmissibility"]} if "transmissibility" in term_info else {}))
     return Ranking(entries, before, pb_before, floor, _nanmean([g.per_band_floor for g in g0]), null,
                    gap_present, verdict, conf, reason, sc.ref_held.bands, settings)
 

@@ -3,7 +3,7 @@
 Summaries are built by hand here (the numbers are chosen, not simulated), so each rule is
 checked on its own: an accepted effect that explains too little, or whose transmissibility
 still disagrees, is "unexplained"; a gap with no accepted effect is "unexplained"; no gap
-and nothing accepted is "none"; a calibration at a search-range edge is never "clear".
+and nothing accepted is "none"; a calibration at a search-range edge is never named.
 """
 import math
 
@@ -79,17 +79,23 @@ def test_gap_without_accepted_effect_is_unexplained_and_no_gap_is_none():
 
 @pytest.mark.parametrize("force,edge", [(200.0, True), (12000.0, True), (11900.0, True),
                                         (4000.0, False)])
-def test_edge_calibration_is_never_clear(force, edge):
+def test_edge_calibration_is_never_named(force, edge):
+    """A winner calibrated at an edge of its search range is not named (not even
+    'ambiguous'): ``unexplained`` with it as the closest and the edge reported -- its value
+    is a bound (on the saved blind sets every such name was wrong)."""
     # 11900 N: u = ln(11900/200)/ln(60) = 0.998, inside EDGE_TOL of the upper end
     d = decide(_summary(force=force))
-    assert d["verdict"] == "leaf_friction"
-    assert (d["confidence"] == "ambiguous") is edge
     assert bool(d["edge"]) is edge
+    if edge:
+        assert d["verdict"] == "unexplained" and d["confidence"] == "none"
+        assert d["closest"] == "leaf_friction" and "edge of its search range" in d["reason"]
+    else:
+        assert d["verdict"] == "leaf_friction" and d["confidence"] == "clear"
 
 
 def test_edge_in_any_fold_counts():
     d = decide(_summary(folds=[4000.0, 12000.0]))
-    assert d["confidence"] == "ambiguous" and d["edge"] == ["leaf_friction.force"]
+    assert d["verdict"] == "unexplained" and d["edge"] == ["leaf_friction.force"]
 
 
 def test_edge_parameters_linear_and_log():
