@@ -344,7 +344,9 @@ def main(argv=None) -> int:
     ap.add_argument("--first-seed", type=int, default=1)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--max-iter", type=int, default=10)
-    ap.add_argument("--channels", default="axle3")
+    ap.add_argument("--channels", default=None,
+                    help="as `eroad invert --channels` (default: axle 3; with --effects-auto chosen by the "
+                         "verdict, diagnosis.closed_loop.loop_channels)")
     ap.add_argument("--root", default="/tmp/eroad-bench-inverse")
     ap.add_argument("--data-root", default=None,
                     help="where the synthetic datasets are made or found (default: ROOT); share "

@@ -45,9 +45,10 @@ def register(subparsers) -> None:
     p.add_argument("--candidates", type=int, default=None,
                    help="phase realisations tried in the selection (default 16, 6 with --quick; 0: keep the fit's)")
     p.add_argument("--max-iter", type=int, default=None, help="most fit iterations (default 12, 3 with --quick)")
-    p.add_argument("--channels", default="axle3",
-                   help="fitted channels: 'axle3' (susp_disp and axle_acc 3L,3R; default), 'all' (every response "
-                        "channel), or a comma list")
+    p.add_argument("--channels", default=None,
+                   help="fitted channels: 'axle3' (susp_disp and axle_acc 3L,3R; the default), 'axles' "
+                        "(axle_acc of every axle + susp_disp 3L,3R; the default of --effects auto where the "
+                        "diagnosis finds no gap), 'all' (every response channel), or a comma list")
     p.add_argument("--effect", action="append", default=[], metavar="NAME[.PARAM]=VALUE",
                    help="effect added to the nominal model (repeatable), e.g. leaf_friction")
     p.add_argument("--effects", choices=("auto",), default=None,

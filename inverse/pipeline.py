@@ -81,6 +81,10 @@ class InversionConfig:
         Which model-form term the reported uncertainty carries
         (:data:`inverse.uncertainty.MODEL_FORMS`): "diagnosed" where the diagnosis found no
         gap on this drive or named the effect the fit carries (``diagnosis.closed_loop``).
+    calibration : str, optional
+        Key of the uncertainty calibration (:data:`inverse.uncertainty.CALIBRATIONS`,
+        :func:`inverse.uncertainty.calibration_key`: fit model and channel set); None: the
+        fit model's own (its axle-3 calibration).
     """
 
     k: int | None = None
@@ -99,6 +103,7 @@ class InversionConfig:
     fit_model: str = "simulation"
     linear_corrections: int = 2
     model_form: str = "open"
+    calibration: str | None = None
 
 
 #: a fitted parameter this close to a bound is reported as on it (w [-]; ln Gq_n0 [-])
@@ -173,7 +178,7 @@ class Inversion:
         prop = self.segmentation.proportions
         for k, s in enumerate(self.fit.segments):
             d = s.as_dict()
-            fm = self.config.fit_model
+            fm = self.config.calibration or self.config.fit_model
             sd = honest_sd(d["sd"], d.get("sd_ln_G_n_best"), d["objective"], d["n_features"], fit_model=fm,
                            model_form=self.config.model_form)
             iv = {"Gq_n0": interval90(d["Gq_n0"], sd["ln_Gq_n0"], log=True),

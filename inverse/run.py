@@ -36,7 +36,7 @@ import numpy as np
 from eroad.archive import finish_run_info, run_info, write_json_atomic, write_run_json
 from eroad.errors import EroadInputError
 
-__all__ = ["run_inversion", "fit_channels", "noise_psd_from_sd", "check_out", "headline",
+__all__ = ["run_inversion", "fit_channels", "axles_channels", "channel_set", "CHANNEL_SETS", "noise_psd_from_sd", "check_out", "headline",
            "AXLE3_CHANNELS", "RUN_FORMAT"]
 
 #: run-folder format version
@@ -65,11 +65,39 @@ def noise_psd_from_sd(noise_sd: dict, channels, fs: float, src: str = "--noise")
 AXLE3_CHANNELS = ("susp_disp_3L", "susp_disp_3R", "axle_acc_3L", "axle_acc_3R")
 
 
+#: the named channel sets of ``--channels`` besides a comma list
+CHANNEL_SETS = ("axle3", "axles", "all")
+
+
+def axles_channels(available) -> list:
+    """The ``axles`` set: the suspension displacement of axle 3 (both sides) and the axle
+    accelerations of every axle the drive carries (both sides). Every axle sees the same
+    tracks a few metres apart, so their accelerations average the noise and the road's
+    realisation over more stations; the suspension displacements of the other axles are left
+    out because they carry the body's motion, where a vehicle difference (a flexible frame)
+    shows most (results/inverse_blind/20261124-channels-all-axles/)."""
+    return ["susp_disp_3L", "susp_disp_3R"] + sorted(c for c in available if c.startswith("axle_acc_"))
+
+
+def channel_set(names, available) -> str:
+    """The name of a fitted channel list: 'axle3', 'axles', 'all' when it is that set of
+    the drive ``available``, else 'custom' (the key of its uncertainty calibration,
+    :func:`inverse.uncertainty.calibration_key`)."""
+    got = set(names)
+    for spec in CHANNEL_SETS:
+        if got == set(fit_channels(available, spec)):
+            return spec
+    return "custom"
+
+
 def fit_channels(available, spec) -> list:
-    """Fitted channels from ``spec`` ('axle3', 'all' or a comma list / sequence)."""
+    """Fitted channels from ``spec`` ('axle3' (default for None), 'axles', 'all' or a comma
+    list / sequence)."""
     resp = [c for c in available if c.split("_")[0] in ("susp", "axle", "body")]
     if spec is None or spec == "axle3":
         names = [c for c in AXLE3_CHANNELS if c in resp]
+    elif spec == "axles":
+        names = [c for c in axles_channels(resp) if c in resp]
     elif spec == "all":
         names = list(resp)
     else:
@@ -119,7 +147,11 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         Effects of the nominal model.
     chassis : str
     channels : str or sequence of str
-        Fitted (and simulated) channels: 'axle3' (default), 'all' or names.
+        Fitted (and simulated) channels: 'axle3' (default; also for None), 'axles'
+        (:func:`axles_channels`), 'all' or names. The reported intervals take the
+        uncertainty calibration of the fit model and this channel set where there is one
+        (``summary["fit"]["uncertainty_calibration"]`` says which, and whether it was
+        calibrated for these channels).
     argv : list of str, optional
         Command line recorded in run.json.
     noise_sd : dict, optional
@@ -195,8 +227,11 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     bounds = ParamBounds(nmax=(1.0, nmax_cap(SIM_DX)))
     fs = 1.0 / float(np.median(np.diff(time)))
     noise_psd = noise_psd_from_sd(noise_sd, list(drive.channel_names), fs) if noise_sd else None
+    from inverse.uncertainty import calibration_key
+    cset = channel_set(list(chans), drive.channel_names)
+    ckey, calibrated = calibration_key(fit_model, cset)
     icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd,
-                           fit_model=fit_model, model_form=model_form)
+                           fit_model=fit_model, model_form=model_form, calibration=ckey)
     make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans))
     predict = TruckPredictRms(drive.vehicle, ("susp_disp_3L", "susp_disp_3R"), chassis=chassis, effects=effects)
 
@@ -312,7 +347,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                               "spread": sel["spread"],
                               "candidates": sel["candidates"],
                               "fit_phases_errors": headline(fit_rows)},
-                "fit": inv.summary()["fit"],
+                "fit": {**inv.summary()["fit"], "channels": list(chans), "channel_set": cset,
+                        "uncertainty_calibration": ckey, "uncertainty_calibrated_for_channels": calibrated},
                 "segmentation": inv.summary()["segmentation"],
                 "road": {"file": "road.npz", "crg": "road.crg", "seed": sel["seed"], "dx": SIM_DX,
                          "seg_lengths_m": [float(v) for v in sim.layout()["seg_lengths"]]},
@@ -342,6 +378,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                    "workers": workers, "seed": seed, "quick": quick, "candidates": n_cand, "max_iter": iters,
                    "chassis": chassis, "channels": list(chans), "effects": json.dumps(effects or {}),
                    "fit_model": fit_model, "selection": selection, "model_form": model_form,
+                   "channel_set": cset, "uncertainty_calibration": ckey,
                    "simulator": {"dx_m": SIM_DX, "nmax_cap_cpm": nmax_cap(SIM_DX)},
                    "bounds": {k: list(getattr(bounds, k)) for k in ("Gq_n0", "w", "nmin", "nmax")}}
             (tmp / "config.toml").write_text(tomli_w.dumps(cfg))

@@ -73,3 +73,43 @@ def test_a_corrected_fit_that_stays_poor_says_what_is_left():
 
     m = still_poor_message({"status": "poor", "poor_segments": [1, 3]}, {"leaf_friction": {"force": 2221.0}})
     assert "1, 3" in m and "even with leaf_friction" in m and "run the diagnosis" not in m
+
+
+@pytest.mark.parametrize("verdict, given, expect", [
+    ("none", None, "axles"),
+    ("unexplained", None, "axle3"),
+    ("leaf_friction", None, "axle3"),
+    (None, None, "axle3"),
+    ("none", "axle3", "axle3"),
+    ("leaf_friction", "all", "all"),
+])
+def test_channels_follow_the_verdict_unless_given(verdict, given, expect):
+    """Every axle's accelerations only where the diagnosis found no gap; a vehicle difference
+    left in the model would reach more channels (friction drives: G(1) 80 % -> 63 %); a
+    caller's choice is kept and then no reason is added."""
+    from diagnosis.closed_loop import loop_channels
+
+    chans, why = loop_channels(verdict, given)
+    assert chans == expect
+    assert bool(why) == (given is None and verdict == "none")
+
+
+def test_a_none_verdict_fits_every_axle_with_its_own_calibration(tmp_path):
+    """A diagnosis answering 'none' (given): the nominal inversion fits the 'axles' set, records
+    it and the calibration it used, and says so in the reason."""
+    from drives.synth import synth_command
+    from inverse.run import axles_channels
+
+    ds = tmp_path / "ds"
+    synth_command(scenario="null", seed=3, duration=8.0, out=ds)
+    diag = tmp_path / "diag"
+    diag.mkdir()
+    (diag / "summary.json").write_text(json.dumps({"verdict": "none", "verdict_confidence": "none"}))
+    s = invert_closed_loop(ds, tmp_path / "run", workers=1, seed=0, diagnosis=diag, progress=lambda m: None,
+                           segments=1, max_iter=2, candidates=1)
+    fit = s["fit"]
+    assert fit["channel_set"] == "axles" and s["closed_loop"]["channel_set"] == "axles"
+    assert fit["uncertainty_calibration"] == "linear/axles" and fit["uncertainty_calibrated_for_channels"]
+    assert fit["channels"] == axles_channels(fit["channels"]) and len(fit["channels"]) == 10
+    assert fit["model_form"] == "diagnosed" and not s["closed_loop"]["corrected"]
+    assert "channel set 'axles'" in s["closed_loop"]["reason"]

@@ -145,3 +145,18 @@ def test_beta_diagnosed_rule_picks_the_smallest_value_that_covers_90_percent():
              "sd_ln_G_n_best_laplace": 0.01} for x in e]
     rows += [dict(r, model_form="open", lnGq_err=10.0, w_err=10.0, lnG_n_best_err=10.0) for r in rows[:500]]
     assert C.choose_beta_diagnosed(rows, const) == {"ln_Gq_n0": 0.1, "w": 0.1, "ln_G_n_best": 0.1}
+
+
+def test_calibration_key_per_channel_set():
+    """Each channel set takes its own constants where they were calibrated (the 'axles' set of
+    the linear fit: its correlated channels need a larger KAPPA); any other list falls back to
+    the fit model's axle-3 constants and says it was not calibrated for them."""
+    assert U.calibration_key("linear", "axle3") == ("linear", True)
+    assert U.calibration_key("linear", "axles") == ("linear/axles", True)
+    assert U.calibration_key("linear", "custom") == ("linear", False)
+    assert U.calibration_key("simulation", "axles") == ("simulation", False)
+    ax, lin = U.calibration("linear/axles"), U.calibration("linear")
+    assert all(ax["KAPPA"][q] > lin["KAPPA"][q] for q in lin["KAPPA"])
+    assert ax["R_GATE"] == pytest.approx(5 * ax["R_REF"], rel=0.01)
+    with pytest.raises(ValueError):
+        U.calibration_key("quarter", "axle3")
