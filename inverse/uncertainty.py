@@ -118,15 +118,18 @@ CALIBRATIONS = {
     # correlated (every axle follows the same two tracks), so the Laplace sd is further from
     # the truth's scatter (noise-only intervals held in 49-54 % of the null segments) and
     # KAPPA is larger. Same rules as above (2026-11-24; calibrate_uncertainty.py --calibrate
-    # on the 20 null drives, --beta-from on the 20 friction drives, --beta-diagnosed-from on
-    # the 20 friction drives with the loop closed, all fitted with these channels;
-    # results/inverse_blind/20261124-channels-all-axles/acc-every-axle/, printout in
-    # results/inverse_blind/20261124-axles-when-none/calibration.txt). Split-half check of
-    # KAPPA on the null drives: 85-97 % per half.
+    # on the 20 null drives, --beta-from on the 20 friction drives, all fitted with these
+    # channels, results/inverse_blind/20261124-channels-all-axles/acc-every-axle/); split-half
+    # check of KAPPA on the null drives: 85-97 % per half. BETA_DIAGNOSED by the rule above on
+    # the two families pooled, as for axle 3: the friction drives with the loop closed (53
+    # diagnosed segments) and the 4 drives of the independent truck the diagnosis answered
+    # 'none' (15 segments); on the friction drives alone w would get 0, which held w in 11 of
+    # the independent truck's 15 segments (0.01: 13). Printout and commands in
+    # results/inverse_blind/20261124-axles-when-none/.
     "linear/axles": {"R_REF": 0.521, "R_GATE": 2.6,
                      "KAPPA": {"ln_Gq_n0": 2.49, "w": 2.86, "ln_G_n_best": 2.71},
                      "BETA": {"ln_Gq_n0": 0.5, "w": 0.05, "ln_G_n_best": 0.2},
-                     "BETA_DIAGNOSED": {"ln_Gq_n0": 0.1, "w": 0.0, "ln_G_n_best": 0.05}},
+                     "BETA_DIAGNOSED": {"ln_Gq_n0": 0.1, "w": 0.01, "ln_G_n_best": 0.05}},
 }
 
 
