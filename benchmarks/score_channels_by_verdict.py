@@ -64,7 +64,12 @@ def main(argv=None) -> int:
     ap.add_argument("sets", nargs="+", metavar="NAME=CL_ROOT,AXLES_ROOT")
     ap.add_argument("--verdicts", action="append", default=[], metavar="NAME=DIAG_ROOT")
     ap.add_argument("--min-s", type=float, default=3.0)
+    ap.add_argument("--beta-diagnosed-from", default=None, metavar="CL_AXLES_ROOT",
+                    help="also choose the axles set's BETA_DIAGNOSED by calibrate_uncertainty's rule on the "
+                         "diagnosed rows of this closed-loop set fitted on 'axles' pooled with the 'none' "
+                         "drives' rows of the sets above (and on each alone)")
     a = ap.parse_args(argv)
+    pool = {}
     verdicts = {n: redecided_loops(Path(d)) for n, _, d in (v.partition("=") for v in a.verdicts)}
     print("| set | drives 'none' | segments | rule | 90 % cover ln Gq(n0) | w | ln G(n_best) "
           "| G(1 cycle/m) within 20 % | class right |")
@@ -87,6 +92,7 @@ def main(argv=None) -> int:
             if r["seed"] in none:
                 r["model_form"] = "diagnosed"
                 mixed.append((r, interval_holds(r, "linear/axles")))
+                pool.setdefault(name, []).append(r)
         n_none = len(none)
         print(f"| {name} | {n_none}/{len(verdict)} | {len(base)} | axle 3 | {score(base)} |")
         print(f"| {name} | {n_none}/{len(verdict)} | {len(mixed)} | by verdict | {score(mixed)} |")
@@ -95,6 +101,15 @@ def main(argv=None) -> int:
             sub0 = [(r, h) for r, h in base if r["seed"] in none]
             print(f"| {name}, the 'none' drives | {n_none} | {len(sub)} | axle 3 | {score(sub0)} |")
             print(f"| {name}, the 'none' drives | {n_none} | {len(sub)} | axles | {score(sub)} |")
+    if a.beta_diagnosed_from:
+        from calibrate_uncertainty import choose_beta_diagnosed
+
+        const = {k: (dict(v) if isinstance(v, dict) else v) for k, v in U.calibration("linear/axles").items()}
+        fams = {"closed loop on axles": [r for r in load(Path(a.beta_diagnosed_from), a.min_s)
+                                         if r["model_form"] == "diagnosed"], **pool}
+        print()
+        for label, rows in [("pooled", [r for v in fams.values() for r in v]), *fams.items()]:
+            print(f"BETA_DIAGNOSED (axles) chosen on {label} ({len(rows)} segments): {choose_beta_diagnosed(rows, const)}")
     return 0
 
 

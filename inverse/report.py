@@ -116,6 +116,18 @@ def table1_note(fit_quality: dict | None = None, road_model: bool = True, segmen
     return note
 
 
+def channels_note(channel_set: str, calibrated: bool) -> str:
+    """One sentence under Table 1: which channels were fitted and whether the intervals were
+    calibrated for them (``inverse.uncertainty.calibration_key``)."""
+    what = {"axle3": "suspension displacement and axle acceleration of axle 3",
+            "axles": "axle accelerations of every axle and the suspension displacement of axle 3",
+            "all": "every response channel"}.get(channel_set, "a list of the user's")
+    if calibrated:
+        return f"Fitted channels: '{channel_set}' ({what}); the intervals are calibrated for them."
+    return (f"Fitted channels: '{channel_set}' ({what}); **the intervals use the axle-3 calibration and were "
+            f"not checked on blind drives with these channels**.")
+
+
 #: unit of each Table 2 quantity by channel prefix
 _UNITS = {"axle_acc": "m/s^2", "body_acc": "m/s^2", "susp_disp": "m"}
 

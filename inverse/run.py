@@ -192,8 +192,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     from drives.format import read_drive
     from inverse.pipeline import SEED_KEY_FIT, InversionConfig, invert, stream_seed
     from inverse.realisation import candidate_seeds, select_realisation, select_realisation_linear
-    from inverse.report import (TABLE2_CHANNELS, TABLE2_NOTE, table1, table1_note, table2, write_figures,
-                                write_table)
+    from inverse.report import (TABLE2_CHANNELS, TABLE2_NOTE, channels_note, table1, table1_note, table2,
+                                write_figures, write_table)
     from inverse.uncertainty import overall_fit_quality
     from inverse.sensitivity import FitConfig
     from inverse.spectral import ParamBounds
@@ -355,7 +355,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             }
             summary["lateral"] = lateral
             write_table(table1(segs), tmp / "tables" / "table1",
-                        note=table1_note(summary["fit_quality"], segments=summary["segments"], model_form=model_form) + "\n\n" + note_line(summary["lateral"]))
+                        note=table1_note(summary["fit_quality"], segments=summary["segments"], model_form=model_form)
+                        + " " + channels_note(cset, calibrated) + "\n\n" + note_line(summary["lateral"]))
             basis = ""
             if sel["method"] == "linear":
                 basis = (f" Realisations: {sel['n_simulated']} of {len(seeds)} simulated in time, the others the "

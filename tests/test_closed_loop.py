@@ -113,3 +113,4 @@ def test_a_none_verdict_fits_every_axle_with_its_own_calibration(tmp_path):
     assert fit["channels"] == axles_channels(fit["channels"]) and len(fit["channels"]) == 10
     assert fit["model_form"] == "diagnosed" and not s["closed_loop"]["corrected"]
     assert "channel set 'axles'" in s["closed_loop"]["reason"]
+    assert "Fitted channels: 'axles'" in (tmp_path / "run" / "tables" / "table1.md").read_text()

@@ -30,3 +30,11 @@ def test_other_lists_are_custom_and_default_is_axle3():
     assert channel_set(list(reversed(fit_channels(TRUCK, "axle3"))), TRUCK) == "axle3"
     with pytest.raises(EroadInputError):
         fit_channels(TRUCK, "axle_acc_9L")
+
+
+def test_table1_says_which_channels_and_whether_calibrated():
+    from inverse.report import channels_note
+
+    assert "calibrated for them" in channels_note("axles", True)
+    n = channels_note("custom", False)
+    assert "axle-3 calibration" in n and "not checked" in n and "\n" not in n
