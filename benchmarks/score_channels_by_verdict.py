@@ -20,6 +20,8 @@ the verdicts from saved diagnoses as ``calibrate_uncertainty.py`` does.
 Usage::
 
     python benchmarks/score_channels_by_verdict.py NAME=CL_ROOT,AXLES_ROOT [...] [--verdicts NAME=DIAG]
+    python benchmarks/score_channels_by_verdict.py NAME=ROOT      # a set run with the choice itself (its fits,
+                                                                  # today's constants)
 
 Prints, per set, segments >= 3 s: the 90 % coverage of ln Gq(n0), w, ln G(n_best), G(1
 cycle/m) within 20 % and class right, for axle 3 throughout and for the choice by verdict.
@@ -28,6 +30,7 @@ Nothing is written.
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -76,12 +79,22 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|---|---|---|---|")
     for item in a.sets:
         name, _, roots = item.partition("=")
+        if "," not in roots:          # a closed-loop set run with the choice by verdict itself
+            rows = load(Path(roots), a.min_s)
+            rec = {json.loads(li)["seed"]: (json.loads(li).get("closed_loop") or {}).get("verdict")
+                   for li in (Path(roots) / "results.jsonl").read_text().splitlines() if li.strip()}
+            none = {s for s, v in rec.items() if v == "none"}
+            got = [(r, interval_holds(r, "linear/axles" if r["seed"] in none else "linear")) for r in rows]
+            print(f"| {name} | {len(none)}/{len(rec)} | {len(got)} | by verdict (fits as run) | {score(got)} |")
+            sub = [(r, h) for r, h in got if r["seed"] in none]
+            if sub:
+                print(f"| {name}, the 'none' drives | {len(none)} | {len(sub)} | axles (fits as run) | {score(sub)} |")
+            continue
         cl_root, ax_root = (Path(p) for p in roots.split(","))
         loops = verdicts.get(name)
         cl = load(cl_root, a.min_s, loops=loops)
         ax = load(ax_root, a.min_s)
         # the verdict per seed: re-decided, or as the closed-loop records hold it
-        import json
         recorded = {json.loads(li)["seed"]: (json.loads(li).get("closed_loop") or {}).get("verdict")
                     for li in (cl_root / "results.jsonl").read_text().splitlines() if li.strip()}
         verdict = {s: (loops[s][0] if loops and s in loops else v) for s, v in recorded.items()}
