@@ -212,11 +212,11 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
             fq = chosen.get("fit_quality", {})
             if fq.get("status") == "poor":   # the named effect did not make the model explain it
                 fq["message"] = still_poor_message(fq, effects)
-                from inverse.report import channels_note, table1, table1_note
+                from inverse.report import table1, table1_note
                 fit = chosen["fit"]
                 write_table(table1(chosen["segments"]), main / "tables" / "table1",
-                            note=table1_note(fq, segments=chosen["segments"], model_form=fit["model_form"])
-                            + " " + channels_note(fit["channel_set"], fit["uncertainty_calibrated_for_channels"]))
+                            note=table1_note(fq, segments=chosen["segments"], model_form=fit["model_form"],
+                                             channels=(fit["channel_set"], fit["uncertainty_calibrated_for_channels"])))
         else:
             chosen, main = nominal, work / "nominal"
         (work / "diagnose").rename(main / "diagnose")

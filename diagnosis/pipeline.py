@@ -1126,9 +1126,11 @@ def transmissibility_term(model: TruckModel):
     every wheel position with an axle and a body acceleration."""
     from diagnosis.which import TransmissibilityTerm
 
+    if not TRANSMISSIBILITY_TERM:
+        return None
     pairs = [(c, "body_acc_" + c[len("axle_acc_"):]) for c in model.channels
              if c.startswith("axle_acc_") and "body_acc_" + c[len("axle_acc_"):] in model.channels]
-    return TransmissibilityTerm(pairs) if pairs and TRANSMISSIBILITY_TERM else None
+    return TransmissibilityTerm(pairs) if pairs else None
 
 
 def shape_term(model: TruckModel):

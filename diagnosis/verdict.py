@@ -429,7 +429,7 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
         # a winner pinned at its search range's end is not an estimate: the data ask for
         # more than the range holds; on the saved blind sets every such name was wrong (3 of
         # 3, independent truck: payload -> damper ratio at 6, leaf friction -> payload at
-        # +14 t), none right (EDGE_IS_UNEXPLAINED, docs/diagnosis.md)
+        # +14 t), none right (docs/diagnosis.md, "Verdict")
         short.append(f"it calibrates at the edge of its search range ({', '.join(edges)}): "
                      "the data ask for more than the range holds")
     res = out["residual"]

@@ -89,11 +89,12 @@ MODEL_FORM_NOTE = {
 
 
 def table1_note(fit_quality: dict | None = None, road_model: bool = True, segments=None,
-                model_form: str | None = None) -> str:
+                model_form: str | None = None, channels: tuple | None = None) -> str:
     """The paragraph under Table 1: what the uncertainty columns mean, and the gate's verdict;
     with ``road_model`` (default: every run reports it) also what the road-model columns
     mean (:data:`ROAD_MODEL_NOTE`); with ``model_form`` which model-form term the intervals
-    carry (:data:`MODEL_FORM_NOTE`)."""
+    carry (:data:`MODEL_FORM_NOTE`); with ``channels`` = (channel set, calibrated) which
+    channels were fitted (:func:`channels_note`)."""
     from inverse.uncertainty import R_GATE
 
     gate = next((r["fit_quality"]["gate"] for r in segments or [] if "gate" in r.get("fit_quality", {})), R_GATE)
@@ -103,6 +104,8 @@ def table1_note(fit_quality: dict | None = None, road_model: bool = True, segmen
             "the segment's data and its numbers are not a clean result.")
     if model_form is not None:
         note += " " + MODEL_FORM_NOTE[model_form]
+    if channels is not None:
+        note += " " + channels_note(*channels)
     if fit_quality and fit_quality.get("status") == "poor":
         note = f"**POOR FIT**: {fit_quality['message']}.\n\n" + note
     if road_model:

@@ -192,8 +192,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     from drives.format import read_drive
     from inverse.pipeline import SEED_KEY_FIT, InversionConfig, invert, stream_seed
     from inverse.realisation import candidate_seeds, select_realisation, select_realisation_linear
-    from inverse.report import (TABLE2_CHANNELS, TABLE2_NOTE, channels_note, table1, table1_note, table2,
-                                write_figures, write_table)
+    from inverse.report import (TABLE2_CHANNELS, TABLE2_NOTE, table1, table1_note, table2, write_figures,
+                                write_table)
     from inverse.uncertainty import overall_fit_quality
     from inverse.sensitivity import FitConfig
     from inverse.spectral import ParamBounds
@@ -328,6 +328,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             simulated = sel["simulated"]
             rows = response_table(chans, simulated, table_ch)
             fit_rows = response_table(chans, sel["fit_simulated"], table_ch) if sel["label"] != "fit" else rows
+            inv_summary = inv.summary()
             summary = {
                 "format": RUN_FORMAT,
                 "dataset": {"name": drive.name, "path": dataset_path(dataset, out), "vehicle": str(drive.vehicle),
@@ -347,16 +348,16 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                               "spread": sel["spread"],
                               "candidates": sel["candidates"],
                               "fit_phases_errors": headline(fit_rows)},
-                "fit": {**inv.summary()["fit"], "channels": list(chans), "channel_set": cset,
+                "fit": {**inv_summary["fit"], "channels": list(chans), "channel_set": cset,
                         "uncertainty_calibration": ckey, "uncertainty_calibrated_for_channels": calibrated},
-                "segmentation": inv.summary()["segmentation"],
+                "segmentation": inv_summary["segmentation"],
                 "road": {"file": "road.npz", "crg": "road.crg", "seed": sel["seed"], "dx": SIM_DX,
                          "seg_lengths_m": [float(v) for v in sim.layout()["seg_lengths"]]},
             }
             summary["lateral"] = lateral
             write_table(table1(segs), tmp / "tables" / "table1",
-                        note=table1_note(summary["fit_quality"], segments=summary["segments"], model_form=model_form)
-                        + " " + channels_note(cset, calibrated) + "\n\n" + note_line(summary["lateral"]))
+                        note=table1_note(summary["fit_quality"], segments=summary["segments"], model_form=model_form,
+                                         channels=(cset, calibrated)) + "\n\n" + note_line(summary["lateral"]))
             basis = ""
             if sel["method"] == "linear":
                 basis = (f" Realisations: {sel['n_simulated']} of {len(seeds)} simulated in time, the others the "
