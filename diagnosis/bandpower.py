@@ -35,6 +35,8 @@ from functools import lru_cache
 import numpy as np
 from scipy import signal, special
 
+from .welch import welch
+
 __all__ = ["third_octave_bands", "BandSpectrum", "band_powers", "band_nperseg",
            "welch_edof", "var_log_power"]
 
@@ -206,8 +208,7 @@ def band_powers(x: np.ndarray, fs: float, bands: np.ndarray | None = None, *,
         L = int(L)
         H = L // 2
         K = 1 + (n - L) // H
-        f, P = signal.welch(x, fs=fs, window="hann", nperseg=L, noverlap=L - H,
-                            detrend="constant", scaling="density", axis=-1)
+        f, P = welch(x, fs, L, hop=H)
         df = fs / L
         for b in np.flatnonzero(Ls == L):
             lo, _, hi = bands[b]

@@ -59,13 +59,14 @@ from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
-from scipy import signal, stats
+from scipy import stats
 
 from eroad.errors import EroadInputError
 
 from .bandpower import band_nperseg, third_octave_bands, welch_edof
 from .fdr import benjamini_hochberg, fcr_level
 from .signals import as_signals
+from .welch import cross_spectra, segment_ffts
 
 __all__ = ["Transmissibility", "transmissibility", "TwoInputResponse", "two_input_response",
            "TwoInputTransmissibility", "transmissibility_two_input", "two_input_stations",
@@ -80,11 +81,7 @@ def _num(v):
 
 def _cross(x, y, fs, L):
     """One-sided Welch Pxx, Pyy, Pxy (conj(X) Y) with Hann, 50 % overlap."""
-    kw = dict(fs=fs, window="hann", nperseg=L, noverlap=L - L // 2, detrend="constant")
-    f, pxx = signal.welch(x, **kw)
-    _, pyy = signal.welch(y, **kw)
-    _, pxy = signal.csd(x, y, **kw)
-    return f, pxx, pyy, pxy
+    return cross_spectra(x, y, fs, L)
 
 
 def _band_bins(f, lo, hi):
@@ -311,15 +308,8 @@ class TwoInputResponse:
 def _segment_ffts(sigs, fs, L):
     """Welch segments of the signals ``sigs`` (periodic Hann, hop ``L // 2``, mean removed per
     segment, as ``scipy.signal.welch``): ``f`` and ``X`` (K, nf, m), the segments' FFTs."""
-    w = signal.get_window("hann", L)
-    n = len(sigs[0])
-    K = 1 + (n - L) // (L // 2)
-    starts = np.arange(K) * (L // 2)
-    X = []
-    for s in sigs:
-        seg = np.lib.stride_tricks.sliding_window_view(np.asarray(s, float), L)[starts]
-        X.append(np.fft.rfft((seg - seg.mean(axis=1, keepdims=True)) * w, axis=1))
-    return np.fft.rfftfreq(L, 1.0 / fs), np.stack(X, axis=-1)
+    f, X = segment_ffts(np.array([np.asarray(s, float) for s in sigs]), fs, L)
+    return f, np.moveaxis(X, 0, -1)
 
 
 def _band_spectra(X, idx, n_in, weighting):

@@ -145,7 +145,7 @@ def noise_std(sig: Signals, names, block_s: float = 4.0) -> dict:
     -------
     dict name -> std (channel unit)
     """
-    from scipy import signal
+    from diagnosis.welch import welch
 
     fs = sig.fs
     n = int(block_s * fs)
@@ -157,7 +157,8 @@ def noise_std(sig: Signals, names, block_s: float = 4.0) -> dict:
             seg = x[i0:i0 + n]
             if seg.size < 64:
                 continue
-            f, p = signal.welch(seg - seg.mean(), fs=fs, nperseg=min(256, seg.size))
+            L = min(256, seg.size)
+            f, p = welch(seg - seg.mean(), fs, L, hop=L - L // 2)
             m = (f >= 0.6 * fs / 2) & (f <= 0.95 * fs / 2)
             vals.append(float(np.mean(p[m])))
         psd = min(vals) if vals else 0.0
@@ -181,14 +182,14 @@ def window_noise(meas: dict, sim: dict, fs: float, nperseg: int = 256) -> dict:
     enveloping, leaves more of the measured power there to noise), not once with the
     nominal model.
     """
-    from scipy import signal
+    from diagnosis.welch import welch
 
     names = list(meas)
     X = np.array([meas[c] - np.mean(meas[c]) for c in names])
     Y = np.array([sim[c] - np.mean(sim[c]) for c in names])
     nper = min(int(nperseg), X.shape[1])
-    f, pm = signal.welch(X, fs=fs, nperseg=nper, axis=-1)
-    _, ps = signal.welch(Y, fs=fs, nperseg=nper, axis=-1)
+    f, pm = welch(X, fs, nper, hop=nper - nper // 2)
+    _, ps = welch(Y, fs, nper, hop=nper - nper // 2)
     m = (f >= 0.6 * fs / 2) & (f <= 0.95 * fs / 2)
     d = np.maximum(pm[:, m].mean(axis=1) - ps[:, m].mean(axis=1), 0.0)
     return {c: math.sqrt(float(v) * fs / 2.0) for c, v in zip(names, d)}
@@ -232,7 +233,7 @@ def window_tilt(meas: dict, sim: dict, fs: float, noise: dict) -> float:
     spectra, e.g. a sensor low-pass; without the refit the true effect at its true
     strength could not close its gap).
     """
-    from scipy import signal
+    from diagnosis.welch import welch
 
     from diagnosis.bandpower import third_octave_bands
 
@@ -243,8 +244,9 @@ def window_tilt(meas: dict, sim: dict, fs: float, noise: dict) -> float:
         return 0.0
     X = np.array([meas[c] - np.mean(meas[c]) for c in names])
     Y = np.array([sim[c] - np.mean(sim[c]) for c in names])
-    f, PM = signal.welch(X, fs=fs, nperseg=min(256, X.shape[1]), axis=-1)
-    _, PS = signal.welch(Y, fs=fs, nperseg=min(256, X.shape[1]), axis=-1)
+    L = min(256, X.shape[1])
+    f, PM = welch(X, fs, L, hop=L - L // 2)
+    _, PS = welch(Y, fs, L, hop=L - L // 2)
     for c, pm, ps in zip(names, PM, PS):
         _band_log_ratios(f, pm, ps, 2.0 * noise.get(c, 0.0) ** 2 / fs, bands, 1.0, xs, ys)
     if len(set(np.round(xs, 6))) < 3:
@@ -659,12 +661,13 @@ def _level_logs(model, sig, sim: dict, mk) -> list:
 def _runs_psd(meas: np.ndarray, sim: np.ndarray, runs, fs: float, nperseg: int):
     """(f, P_meas, P_sim): Welch PSDs of the runs ``(i, j)`` of two records (each run's mean
     removed), summed with the run lengths as weights."""
-    from scipy import signal
+    from diagnosis.welch import welch
 
     pm = ps = 0.0
     for i, j in runs:
-        f, p1 = signal.welch(meas[i:j] - meas[i:j].mean(), fs=fs, nperseg=nperseg)
-        _, p2 = signal.welch(sim[i:j] - sim[i:j].mean(), fs=fs, nperseg=nperseg)
+        L = min(int(nperseg), j - i)
+        f, p1 = welch(meas[i:j] - meas[i:j].mean(), fs, L, hop=L - L // 2)
+        _, p2 = welch(sim[i:j] - sim[i:j].mean(), fs, L, hop=L - L // 2)
         pm, ps = pm + p1 * (j - i), ps + p2 * (j - i)
     return f, pm, ps
 
