@@ -33,7 +33,8 @@ mean (z_left + z_right)/2 and the step disappears.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections import OrderedDict
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -64,6 +65,42 @@ def _window_slope_constant() -> float:
 
 #: max |h'(u)| * sx of the window shape (dimensionless, about 0.69)
 WINDOW_SLOPE = _window_slope_constant()
+
+#: level at which a segment is synthesised before it is scaled to its own: the field is
+#: linear in the harmonics' amplitudes, which are proportional to sqrt(Gq_n0), so a segment
+#: of level Gq_n0 is sqrt(Gq_n0 / UNIT_GQ) times the unit one of the same phases
+UNIT_GQ = 1e-6
+#: unit segments kept per process (the inversion and the diagnosis draw the same phases
+#: at many levels; one entry is the segment's grid and its two end evaluations, about
+#: 0.1-1 MB for the roads they draw)
+UNIT_CACHE_SIZE = 64
+_unit_cache: OrderedDict = OrderedDict()
+
+
+def _unit_segment(params: SpectralParams, seg_len: float, width: float, lateral: bool,
+                  seed: int, s: int, x_first: float, n_rows: int, y: np.ndarray, dx: float):
+    """Segment ``s`` of the road of ``seed`` at level ``UNIT_GQ``: its grid (n_rows, ny) from
+    ``x_first`` and its exact heights half a step before its first and after its last row
+    (where the junctions sit).  Cached: only the level differs between many calls."""
+    unit = replace(params, Gq_n0=UNIT_GQ)
+    key = (unit, float(seg_len), float(width), bool(lateral), int(seed), int(s), float(x_first),
+           int(n_rows), y.tobytes(), float(dx))
+    hit = _unit_cache.get(key)
+    if hit is not None:
+        _unit_cache.move_to_end(key)
+        return hit
+    f = harmonic_field(unit, seg_len, width, np.random.SeedSequence(int(seed), spawn_key=(int(s),)),
+                       lateral=lateral)
+    zu = f.grid(x_first, n_rows, y)
+    x_end = x_first + (n_rows - 1) * dx
+    ends = (f.evaluate(np.full(y.size, x_first - 0.5 * dx), y),
+            f.evaluate(np.full(y.size, x_end + 0.5 * dx), y))
+    for a in (zu, *ends):
+        a.setflags(write=False)
+    _unit_cache[key] = (zu, ends)
+    if len(_unit_cache) > UNIT_CACHE_SIZE:
+        _unit_cache.popitem(last=False)
+    return zu, ends
 
 
 @dataclass(frozen=True)
@@ -204,13 +241,13 @@ def segmented_surface(segments, length: float, width: float, dx: float, dy: floa
                 "lengthen the road or its share")
 
     z = np.empty((nx, ny))
-    fields = []
+    ends = []
     for s, (a, b) in enumerate(zip(first, last)):
-        ss = np.random.SeedSequence(int(seed), spawn_key=(s,))
-        seg_len = (b - a) * dx
-        f = harmonic_field(params[s], seg_len, width, ss, lateral=ny > 1)
-        z[a:b + 1] = f.grid(x[a], b - a + 1, y)
-        fields.append(f)
+        zu, e = _unit_segment(params[s], (b - a) * dx, width, ny > 1, int(seed), s, float(x[a]),
+                              b - a + 1, y, dx)
+        g = math.sqrt(params[s].Gq_n0 / UNIT_GQ)
+        z[a:b + 1] = g * zu
+        ends.append((g * e[0], g * e[1]))
 
     steps = np.abs(np.diff(z, axis=0))
     mask = np.ones(nx - 1, bool)
@@ -221,7 +258,7 @@ def segmented_surface(segments, length: float, width: float, dx: float, dy: floa
     junctions = []
     for j, c in enumerate(cut):
         xj = x[c] + 0.5 * dx
-        d = fields[j + 1].evaluate(np.full(ny, xj), y) - fields[j].evaluate(np.full(ny, xj), y)
+        d = ends[j + 1][0] - ends[j][1]    # both exact at x_j (right field's start, left's end)
         a_lat = _solve_lateral(y, 0.5 * d, sy)
         half = 0.5 * float(np.max(np.abs(d)))
         sx_need = WINDOW_SLOPE * half * dx / (PATCH_STEP_FRACTION * med_step) if med_step > 0 else 0.0

@@ -67,6 +67,31 @@ def test_segmented_same_seed_same_bytes():
     assert not np.array_equal(a.z, c.z)
 
 
+def test_level_scaling_and_the_unit_cache():
+    """A segment is its unit-level synthesis scaled by sqrt(Gq_n0 / UNIT_GQ) (the synthesis
+    is linear in the amplitudes), cached per process.  A road with every level times 4 is
+    the same road times 2 (the junction patches scale too: their width depends on the
+    ratio of step to median step); tolerance 1e-12 of the road's range, rounding only.  A
+    cache miss and a hit give the same bytes, and a fresh harmonic field of the segment's own
+    level (no cache) agrees to rounding."""
+    import roadlib.segments as seg
+    from roadlib.synthesis import harmonic_field
+
+    segs = [RoadSegment.from_class("B", share=2), RoadSegment.from_class("D", share=1, w=2.4)]
+    a = segmented_surface(segs, 80.0, 1.0, 0.05, 0.1, seed=5)
+    b = segmented_surface([RoadSegment(Gq_n0=4 * sg.Gq_n0, share=sg.share, w=sg.w) for sg in segs],
+                          80.0, 1.0, 0.05, 0.1, seed=5)
+    tol = 1e-12 * np.ptp(a.z)
+    np.testing.assert_allclose(b.z, 2.0 * a.z, rtol=0, atol=2 * tol)
+    seg._unit_cache.clear()
+    c = segmented_surface(segs, 80.0, 1.0, 0.05, 0.1, seed=5)
+    assert c.z.tobytes() == a.z.tobytes()
+    p0 = segs[0].params(0.05, 0.1)
+    n0 = int(round(a.meta["junctions"][0]["x"] / 0.05 - 0.5)) + 1
+    f = harmonic_field(p0, (n0 - 1) * 0.05, 1.0, np.random.SeedSequence(5, spawn_key=(0,)))
+    np.testing.assert_allclose(f.grid(0.0, 10, a.y), a.z[:10], rtol=0, atol=tol)
+
+
 def test_single_segment_is_a_plain_surface():
     s = segmented_surface([RoadSegment.from_class("C")], 50.0, 1.0, 0.1, 0.1, seed=9)
     assert s.meta["junctions"] == [] and s.z.shape == (501, 11)

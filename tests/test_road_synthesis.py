@@ -1,4 +1,6 @@
 """Harmonic synthesis (roadlib.synthesis): scale, waviness, anisotropy, seeds, fast path."""
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -163,3 +165,19 @@ def test_nyquist_harmonic_consistent():
     zg = f.grid(0.3, 1001, y)
     ze = f.evaluate((0.3 + np.arange(1001) * 0.1)[:, None], y[None, :])
     assert np.max(np.abs(ze - zg)) < 1e-12 * np.std(zg)
+
+
+@pytest.mark.parametrize("width, nmin, nmax", [(0.0, 0.1, 5.0), (3.0, 0.1, 5.0), (3.0, 0.011, 2.0)])
+def test_phases_are_those_of_the_whole_grid(width, nmin, nmax):
+    """The phases jump to the band's first bin in the PCG64 stream (a speed-up): they must
+    be those of drawing one phase per bin of the whole grid and lateral harmonic (the
+    documented rule that makes roads of one seed comparable across bands).  Tolerance
+    1e-12 relative: |a e^(i phi)| and a differ by rounding only; a phase from another
+    place in the stream is off by O(1)."""
+    p = dataclasses.replace(SpectralParams.from_class("C"), nmin=nmin, nmax=nmax)
+    ss = np.random.SeedSequence(7, spawn_key=(3,))
+    f = harmonic_field(p, 200.0, width, ss)
+    n_bins = f.n_fft // 2 + 1
+    phi = np.random.default_rng(ss).uniform(0.0, 2.0 * np.pi, size=(n_bins, f.m.size))[f.k]
+    assert f.k[0] > 0 and f.m.size == (1 if width == 0 else f.m.size)
+    np.testing.assert_allclose(f.coef, np.abs(f.coef) * np.exp(1j * phi), rtol=1e-12, atol=0)
