@@ -488,9 +488,11 @@ class Ranking:
         return [e.record() for e in self.entries]
 
 
+@dataclass
 class WindowTerm:
     """A road-independent per-window statistic compared between simulation and measurement,
-    as a term of the gap (base of :class:`DelayTerm` and :class:`ShapeTerm`).
+    as a term of the gap (base of :class:`DelayTerm`, :class:`ShapeTerm` and
+    :class:`TransmissibilityTerm`).
 
     Subclasses give ``stats(windows) -> (W, P) array`` (one value per window and channel or
     channel pair, NaN where none) and ``_rho(sim, meas) -> (W,)`` (the per-window mismatch,
@@ -503,8 +505,13 @@ class WindowTerm:
     so that the term's standard deviation under a correct model (``weight sqrt 2``,
     ``z^2 ~ chi2(1)``) is half the standard deviation of the nominal-vs-nominal band gap.
     With common random numbers the term is the same for every model that does not change
-    the statistic.  Needs attributes ``weight``, ``_meas`` and ``_sigma`` (dicts).
+    the statistic.  ``weight`` is keyword-only (after every subclass's own fields);
+    ``_meas`` and ``_sigma`` hold the prepared statistics per window set.
     """
+
+    weight: float = field(default=0.0, kw_only=True)
+    _meas: dict = field(default_factory=dict, repr=False, kw_only=True)
+    _sigma: dict = field(default_factory=dict, repr=False, kw_only=True)
 
     #: floor of the per-window standard deviation of the statistic
     SIGMA_FLOOR = 0.0
@@ -590,9 +597,6 @@ class DelayTerm(WindowTerm):
     distances: list
     f_lo: float = 1.0
     f_hi: float = 30.0
-    weight: float = 0.0
-    _meas: dict = field(default_factory=dict, repr=False)
-    _sigma: dict = field(default_factory=dict, repr=False)
 
     #: lag search per pair: LAG_LO to LAG_HI x the axle distance, in recorded distance
     #: (covers speed factors 0.7-1.4)
@@ -657,9 +661,6 @@ class ShapeTerm(WindowTerm):
     """
 
     channels: list
-    weight: float = 0.0
-    _meas: dict = field(default_factory=dict, repr=False)
-    _sigma: dict = field(default_factory=dict, repr=False)
 
     #: skewness of a 7.5 s window scatters by about 0.1-0.3 between road phases; a floor
     #: keeps a window whose nominal seeds happen to agree from dominating
@@ -707,9 +708,6 @@ class TransmissibilityTerm(WindowTerm):
     f_lo: float = 2.0
     f_hi: float = 20.0
     min_coherence: float = 0.3
-    weight: float = 0.0
-    _meas: dict = field(default_factory=dict, repr=False)
-    _sigma: dict = field(default_factory=dict, repr=False)
 
     SIGMA_FLOOR = 0.01
     label = "transmissibility"
