@@ -407,7 +407,7 @@ class TruckModel:
         road = self._road(t0, t1, seed, gq)
         prof = SpeedProfile(tau, v)
         dur = (tau.size - 1) / self.fs
-        res = simulate(self.vehicle, road, prof, dur, effects=effects or None, x_start=x_start,
+        res = simulate(self._vp(), road, prof, dur, effects=effects or None, x_start=x_start,
                        fs_out=self.fs, seed=int(seed))
         out = {}
         for c in self.channels:

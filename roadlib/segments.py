@@ -93,8 +93,7 @@ def _unit_segment(params: SpectralParams, seg_len: float, width: float, lateral:
                        lateral=lateral)
     zu = f.grid(x_first, n_rows, y)
     x_end = x_first + (n_rows - 1) * dx
-    ends = (f.evaluate(np.full(y.size, x_first - 0.5 * dx), y),
-            f.evaluate(np.full(y.size, x_end + 0.5 * dx), y))
+    ends = (f.row(x_first - 0.5 * dx, y), f.row(x_end + 0.5 * dx, y))
     for a in (zu, *ends):
         a.setflags(write=False)
     _unit_cache[key] = (zu, ends)

@@ -247,6 +247,22 @@ class HarmonicField:
             out[s:s + step] = np.einsum("pk,pk->p", ex, b).real
         return out.reshape(shape)
 
+    def row(self, x: float, y=0.0) -> np.ndarray:
+        """Exact harmonic sum at one position ``x`` and lateral positions ``y``: what
+        :meth:`evaluate` gives there, with the x-sum done once for all ``y``
+        (O(K L + ny L) instead of O(ny K L); the junction heights of a segmented road).
+
+        Returns
+        -------
+        ndarray
+            z [m], shape (ny,).
+        """
+        y = np.atleast_1d(np.asarray(y, float))
+        c = np.exp(1j * 2.0 * np.pi * self.n * float(x)) @ self.coef               # (L,)
+        if self.m.size == 1 and self.m[0] == 0.0:
+            return np.full(y.size, c[0].real)
+        return (np.exp(1j * 2.0 * np.pi * np.outer(y, self.m)) @ c).real
+
     def grid(self, x0: float, nx: int, y=None) -> np.ndarray:
         """Fast path: z on x_i = x0 + i dx (i < nx) and lateral positions ``y``.
 

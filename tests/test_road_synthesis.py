@@ -92,6 +92,8 @@ def test_fast_grid_path_equals_exact_sum():
         j = rng.integers(0, y.size, 200)
         ze = f.evaluate(5.0 + i * p.dx, y[j])
         assert np.max(np.abs(ze - zg[i, j])) < 1e-12 * np.std(zg)
+        # the one-position path (junction heights) is the same sum
+        assert np.max(np.abs(f.row(7.3, y) - f.evaluate(np.full(y.size, 7.3), y))) < 1e-12 * np.std(zg)
     # and the profile generator is that grid path
     x, z = synth_profile(p, 300.0, seed=4, x0=5.0)
     assert np.array_equal(z, harmonic_field(p, 300.0, 0.0, seed=4).grid(5.0, x.size)[:, 0])
