@@ -133,6 +133,9 @@ def _run(args: argparse.Namespace) -> int:
         lat = s["lateral"]
         print(f"lateral offset: max {1e3 * lat['max_abs_offset']:.1f} mm of half-width "
               f"{1e3 * lat['half_width']:.0f} mm (margin {1e3 * lat['margin']:.1f} mm)")
+        note = (s.get("tractor") or {}).get("note")
+        if note:
+            print(f"tractor: {note}")
         w = s["wall"]
         print(f"wall: vehicle {w['vehicle_s']:.1f} s, contact {w['contact_s']:.1f} s")
     for kmh, c in (s.get("reference") or {}).get("cases", {}).items():
@@ -172,5 +175,7 @@ def _run_grid(args: argparse.Namespace) -> int:
           f"{s['lowest_unfiltered_force_N']:.1f} N")
     print(f"lateral offset: at most {s['max_lateral_offset_mm']:.1f} mm of half-width "
           f"{s['head_half_width_mm']:.0f} mm")
+    if s.get("tractor_note"):
+        print(f"tractor (worst configuration): {s['tractor_note']}")
     print(s["path"])
     return 0

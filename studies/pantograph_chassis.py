@@ -89,7 +89,7 @@ TABLE_COLUMNS: tuple = (
     *(f"dF_rms_{_band_label(b)}Hz_N" for b in FORCE_BANDS),
     *(f"vz_rms_{_band_label(b)}Hz_mm_s" for b in FORCE_BANDS),
     "lateral_max_mm", "lateral_rms_mm", "head_half_width_mm", "lateral_margin_mm",
-    "lateral_beyond_percent", "duration_s", "contact_wall_s")
+    "lateral_beyond_percent", "duration_s", "contact_wall_s", "tyre_lift_off_percent")
 
 
 def code_version() -> str:
@@ -245,6 +245,7 @@ def contact_case(case: dict) -> dict:
             "n_spans": int(out["config"]["n_spans"]), "n_dof": int(out["config"]["n_dof"]),
             "wall_vehicle_s": float(out["wall"]["vehicle_s"]),
             "wall_contact_s": float(out["wall"]["contact_s"]),
+            "tyre_lift_off_percent": float(out["tractor"]["tyre_lift_off_percent"]),
             "time": np.asarray(res.time, dtype=float),
             "force": np.asarray(res["force"], dtype=float),
             "base_z": np.asarray(res["base_z"], dtype=float)}
@@ -328,7 +329,9 @@ def collect(cases: list[dict], results: list[dict], lowpass_hz: float = 20.0):
                     "head_half_width_mm": 1e3 * r["lateral_half_width"],
                     "lateral_margin_mm": 1e3 * r["lateral_margin"],
                     "lateral_beyond_percent": r["lateral_beyond_percent"],
-                    "duration_s": r["duration_s"], "contact_wall_s": r["wall_contact_s"]})
+                    "duration_s": r["duration_s"], "contact_wall_s": r["wall_contact_s"],
+                    "tyre_lift_off_percent": (float("nan") if is_still else
+                                              float(r.get("tyre_lift_off_percent", float("nan"))))})
         rows.append(row)
         forces.append(f)
         bases.append(zb)
@@ -345,8 +348,9 @@ def table_markdown(table) -> str:
     base-induced force per band with the base velocity per band."""
     bl = [_band_label(b) for b in FORCE_BANDS]
     lines = ["| frame | mount | Fm [N] | sd [N] | Fm-3sd [N] | min [N] | max [N] | "
-             "loss [%] | base-induced sd [N] | lateral max / half-width [mm] |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "loss [%] | base-induced sd [N] | lateral max / half-width [mm] | "
+             "tyre lift-off [% of drive] |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for _, r in table.iterrows():
         fr = "base still" if r["base"] == "still" else r["frame"]
         mo = "-" if r["base"] == "still" else f"{r['mount']:g}"
@@ -354,7 +358,8 @@ def table_markdown(table) -> str:
                      f"{_f(r['fm_minus_3sd_N'])} | {_f(r['min_N'])} | {_f(r['max_N'])} | "
                      f"{_f(r['loss_percent'], '{:.2f}')} | "
                      f"{_f(r['base_induced_sd_N'], '{:.2f}')} | "
-                     f"{_f(r['lateral_max_mm'])} / {_f(r['head_half_width_mm'], '{:.0f}')} |")
+                     f"{_f(r['lateral_max_mm'])} / {_f(r['head_half_width_mm'], '{:.0f}')} | "
+                     f"{_f(r.get('tyre_lift_off_percent', float('nan')), '{:.2f}')} |")
     lines += ["", "Base-induced contact force dF = F(drive) - F(base still), unfiltered RMS "
               "per band [N], and base vertical velocity RMS per band [mm/s]:", "",
               "| frame | mount | " + " | ".join(f"dF {b} Hz" for b in bl) + " | "
@@ -484,7 +489,17 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
     ax[1, 1].grid(True, axis="y", alpha=0.3)
     fig.suptitle(title or "Contact-force quality against frame and DCDC-mount stiffness",
                  fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, 0.96))
+    from studies.pantograph_contact import LIFT_OFF_LIMIT_PERCENT
+    lift = (drive["tyre_lift_off_percent"].to_numpy(float) if "tyre_lift_off_percent" in drive
+            else np.full(len(drive), np.nan))
+    top = 0.96
+    if np.isfinite(lift).any() and np.nanmax(lift) >= LIFT_OFF_LIMIT_PERCENT:
+        fig.text(0.5, 0.935, f"OUTSIDE THE TRACTOR MODEL'S RANGE: a tyre would lift off in up to "
+                 f"{np.nanmax(lift):.1f} % of the drive (limit {LIFT_OFF_LIMIT_PERCENT:g} %; the "
+                 "model's tyres stay on the road): these statistics are not the truck's",
+                 ha="center", color="C3", fontsize=9, fontweight="bold")
+        top = 0.93
+    fig.tight_layout(rect=(0, 0, 1, top))
     from studies.pantograph_contact import save_png_pdf
     return save_png_pdf(fig, path, dpi=110)
 
@@ -499,6 +514,10 @@ def _summary(table, cases, sweep, road_label: str) -> dict:
         return {"frame": r["frame"], "mount": float(r["mount"]), "sd_N": float(r["sd_N"]),
                 "base_induced_sd_N": float(r["base_induced_sd_N"])}
 
+    from studies.pantograph_contact import LIFT_OFF_LIMIT_PERCENT, tractor_range_note
+
+    lift_max = float(np.nanmax(drive["tyre_lift_off_percent"].to_numpy(float))) \
+        if drive["tyre_lift_off_percent"].notna().any() else float("nan")
     bl = [_band_label(b) for b in FORCE_BANDS]
     band_ms = {b: float(np.mean(drive[f"dF_rms_{b}Hz_N"] ** 2)) for b in bl}
     tot = sum(band_ms.values())
@@ -513,6 +532,9 @@ def _summary(table, cases, sweep, road_label: str) -> dict:
                                     float(drive["base_induced_sd_N"].max())],
         "lowest_sd": pick(drive["sd_N"].idxmin()), "highest_sd": pick(drive["sd_N"].idxmax()),
         "max_loss_percent": float(drive["loss_percent"].max()),
+        "max_tyre_lift_off_percent": lift_max,
+        "tractor_within_model_range": bool(lift_max < LIFT_OFF_LIMIT_PERCENT),
+        "tractor_note": tractor_range_note(lift_max),
         "lowest_unfiltered_force_N": float(drive["unfiltered_min_N"].min()),
         "max_lateral_offset_mm": float(drive["lateral_max_mm"].max()),
         "head_half_width_mm": float(drive["head_half_width_mm"].iloc[0]),

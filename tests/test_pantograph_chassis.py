@@ -124,3 +124,40 @@ def test_cli_grid_needs_a_road(capsys, tmp_path):
     rc = main(["pantograph-contact", "--out", str(tmp_path), "--chassis-grid"])
     err = capsys.readouterr().err
     assert rc != 0 and "--road" in err and "Traceback" not in err
+
+
+def test_tractor_lift_off_reported_per_configuration(tiny):
+    """The tractor's tyre lift-off share is a column (NaN for the still base, whose drive does
+    not move the pantograph) and the summary's worst case, judged against the limit."""
+    from studies.pantograph_contact import LIFT_OFF_LIMIT_PERCENT
+
+    s, t, _, _ = tiny
+    drive = t[t["base"] == "drive"]
+    assert drive["tyre_lift_off_percent"].notna().all()
+    assert t[t["base"] == "still"]["tyre_lift_off_percent"].isna().all()
+    assert s["max_tyre_lift_off_percent"] == pytest.approx(drive["tyre_lift_off_percent"].max())
+    assert s["tractor_within_model_range"] == (s["max_tyre_lift_off_percent"] < LIFT_OFF_LIMIT_PERCENT)
+
+
+def test_tractor_range_note_thresholds():
+    from studies.pantograph_contact import LIFT_OFF_LIMIT_PERCENT, tractor_range_note
+
+    assert tractor_range_note(0.0) is None and tractor_range_note(float("nan")) is None
+    assert "isolated peaks" in tractor_range_note(0.2)
+    assert tractor_range_note(LIFT_OFF_LIMIT_PERCENT).startswith("OUTSIDE THE TRACTOR MODEL'S RANGE")
+
+
+def test_rough_road_drive_is_flagged_outside_the_tractor_range(tmp_path):
+    """ISO class E at 80 km/h: the e-tractor's rear tyres (16 kN static each) see dynamic
+    loads of about 20 kN sd, so a tyre would lift off in far more than 1 % of the samples
+    (67 % over 21 s measured); the drive must say it is outside the model's range."""
+    from roadlib.surface import RoadSurface
+    from studies.pantograph_contact import contact_drive
+
+    road = tmp_path / "road.npz"
+    assert main(["road", "generate", "--class", "E", "--length", "120", "--width", "4", "--seed", "2",
+                 "--out", str(road)]) == 0
+    out = contact_drive(RoadSurface.load(road), speed_kmh=80.0, duration=4.0, compare_static=False)
+    tr = out["tractor"]
+    assert tr["tyre_lift_off_percent"] > 5.0 and not tr["within_model_range"]
+    assert tr["note"].startswith("OUTSIDE THE TRACTOR MODEL'S RANGE")
