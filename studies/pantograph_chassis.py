@@ -494,11 +494,11 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
             else np.full(len(drive), np.nan))
     top = 0.96
     if np.isfinite(lift).any() and np.nanmax(lift) >= LIFT_OFF_LIMIT_PERCENT:
-        fig.text(0.5, 0.935, f"OUTSIDE THE TRACTOR MODEL'S RANGE: a tyre would lift off in up to "
-                 f"{np.nanmax(lift):.1f} % of the drive (limit {LIFT_OFF_LIMIT_PERCENT:g} %; the "
-                 "model's tyres stay on the road): these statistics are not the truck's",
-                 ha="center", color="C3", fontsize=9, fontweight="bold")
-        top = 0.93
+        fig.text(0.5, 0.918, f"OUTSIDE THE TRACTOR MODEL'S RANGE: a tyre would lift off in up to "
+                 f"{np.nanmax(lift):.1f} % of the drive (limit {LIFT_OFF_LIMIT_PERCENT:g} %).\nThe "
+                 "model's tyres stay on the road, so these statistics are not the truck's.",
+                 ha="center", va="bottom", color="C3", fontsize=9, fontweight="bold")
+        top = 0.91
     fig.tight_layout(rect=(0, 0, 1, top))
     from studies.pantograph_contact import save_png_pdf
     return save_png_pdf(fig, path, dpi=110)
