@@ -72,8 +72,9 @@ WINDOW_SLOPE = _window_slope_constant()
 UNIT_GQ = 1e-6
 #: unit segments kept per process (the inversion and the diagnosis draw the same phases
 #: at many levels; one entry is the segment's grid and its two end evaluations, about
-#: 0.1-1 MB for the roads they draw)
+#: 0.1-1 MB for the roads they draw): at most this many entries and this many bytes
 UNIT_CACHE_SIZE = 64
+UNIT_CACHE_BYTES = 128 * 2 ** 20
 _unit_cache: OrderedDict = OrderedDict()
 
 
@@ -97,7 +98,9 @@ def _unit_segment(params: SpectralParams, seg_len: float, width: float, lateral:
     for a in (zu, *ends):
         a.setflags(write=False)
     _unit_cache[key] = (zu, ends)
-    if len(_unit_cache) > UNIT_CACHE_SIZE:
+    while len(_unit_cache) > 1 and (
+            len(_unit_cache) > UNIT_CACHE_SIZE
+            or sum(v[0].nbytes for v in _unit_cache.values()) > UNIT_CACHE_BYTES):
         _unit_cache.popitem(last=False)
     return zu, ends
 

@@ -118,3 +118,15 @@ def test_bad_segment_share_refused():
         RoadSegment.from_class("C", share=0)
     with pytest.raises(EroadInputError, match="unknown ISO 8608 road class"):
         RoadSegment.from_class("Q")
+
+
+def test_unit_cache_bounded_in_bytes(monkeypatch):
+    """The unit cache keeps at most UNIT_CACHE_BYTES of grids (the newest entry always)."""
+    import roadlib.segments as seg
+
+    seg._unit_cache.clear()
+    monkeypatch.setattr(seg, "UNIT_CACHE_BYTES", 1)
+    for sd in range(3):
+        segmented_surface([RoadSegment.from_class("C")], 30.0, 1.0, 0.1, 0.1, seed=sd)
+    assert len(seg._unit_cache) == 1
+    seg._unit_cache.clear()
