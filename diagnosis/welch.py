@@ -15,14 +15,21 @@ does.  ``tests/test_diagnosis_welch.py`` holds the results equal to scipy's to 1
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from scipy import signal
 
 __all__ = ["segment_ffts", "welch", "cross_spectra"]
 
 
+@lru_cache(maxsize=64)
 def _hann(L: int) -> np.ndarray:
-    return signal.get_window("hann", L)
+    """Periodic Hann window of ``L`` samples (cached, read-only: thousands of calls per
+    diagnosis ask for a handful of lengths)."""
+    w = signal.get_window("hann", int(L))
+    w.setflags(write=False)
+    return w
 
 
 def segment_ffts(x, fs: float, L: int, hop: int | None = None):
