@@ -79,11 +79,6 @@ def _num(v):
     return None if v is None or not np.isfinite(v) else float(v)
 
 
-def _cross(x, y, fs, L):
-    """One-sided Welch Pxx, Pyy, Pxy (conj(X) Y) with Hann, 50 % overlap."""
-    return cross_spectra(x, y, fs, L)
-
-
 def _band_bins(f, lo, hi):
     return np.flatnonzero((f >= lo) & (f < hi) & (np.arange(f.size) >= 2))
 
@@ -175,7 +170,7 @@ def _log_h1(x, y, fs, bands, Ls, min_coherence):
     for L in np.unique(Ls):
         L = int(L)
         K = 1 + (n - L) // (L // 2)
-        f, pxx, pyy, pxy = _cross(x, y, fs, L)
+        f, pxx, pyy, pxy = cross_spectra(x, y, fs, L)
         with np.errstate(divide="ignore", invalid="ignore"):
             h = np.abs(pxy) / pxx
             g2 = np.clip(np.abs(pxy) ** 2 / (pxx * pyy), 1e-12, 1.0)
@@ -675,7 +670,7 @@ def gcc_delay(x: np.ndarray, y: np.ndarray, fs: float, *, max_lag: float, f_lo: 
     kmax = min(int(np.ceil(max_lag * fs)), L // 2 - 2)
     if L > n or kmax < 2:
         return float("nan")
-    f, pxx, pyy, pxy = _cross(x, y, fs, L)
+    f, pxx, pyy, pxy = cross_spectra(x, y, fs, L)
     w = np.where((f >= f_lo) & (f <= f_hi) & (pxx > 0) & (pyy > 0), 1.0, 0.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         g = np.where(w > 0, pxy / np.sqrt(pxx * pyy), 0.0)
@@ -817,7 +812,7 @@ def _fisher_band(x, y, fs, bands, Ls):
     for L in np.unique(Ls):
         L = int(L)
         K = 1 + (n - L) // (L // 2)
-        f, pxx, pyy, pxy = _cross(x, y, fs, L)
+        f, pxx, pyy, pxy = cross_spectra(x, y, fs, L)
         with np.errstate(divide="ignore", invalid="ignore"):
             g = np.sqrt(np.clip(np.abs(pxy) ** 2 / (pxx * pyy), 0.0, 1 - 1e-9))
         for b in np.flatnonzero(Ls == L):

@@ -489,11 +489,11 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
     ax[1, 1].grid(True, axis="y", alpha=0.3)
     fig.suptitle(title or "Contact-force quality against frame and DCDC-mount stiffness",
                  fontsize=11)
-    from studies.pantograph_contact import LIFT_OFF_LIMIT_PERCENT
+    from studies.pantograph_contact import LIFT_OFF_LIMIT_PERCENT, tractor_range
     lift = (drive["tyre_lift_off_percent"].to_numpy(float) if "tyre_lift_off_percent" in drive
             else np.full(len(drive), np.nan))
     top = 0.96
-    if np.isfinite(lift).any() and np.nanmax(lift) >= LIFT_OFF_LIMIT_PERCENT:
+    if np.isfinite(lift).any() and not tractor_range(np.nanmax(lift))["within_model_range"]:
         fig.text(0.5, 0.918, f"OUTSIDE THE TRACTOR MODEL'S RANGE: a tyre would lift off in up to "
                  f"{np.nanmax(lift):.1f} % of the drive (limit {LIFT_OFF_LIMIT_PERCENT:g} %).\nThe "
                  "model's tyres stay on the road, so these statistics are not the truck's.",
@@ -514,7 +514,7 @@ def _summary(table, cases, sweep, road_label: str) -> dict:
         return {"frame": r["frame"], "mount": float(r["mount"]), "sd_N": float(r["sd_N"]),
                 "base_induced_sd_N": float(r["base_induced_sd_N"])}
 
-    from studies.pantograph_contact import LIFT_OFF_LIMIT_PERCENT, tractor_range_note
+    from studies.pantograph_contact import tractor_range
 
     lift_max = float(np.nanmax(drive["tyre_lift_off_percent"].to_numpy(float))) \
         if drive["tyre_lift_off_percent"].notna().any() else float("nan")
@@ -533,8 +533,8 @@ def _summary(table, cases, sweep, road_label: str) -> dict:
         "lowest_sd": pick(drive["sd_N"].idxmin()), "highest_sd": pick(drive["sd_N"].idxmax()),
         "max_loss_percent": float(drive["loss_percent"].max()),
         "max_tyre_lift_off_percent": lift_max,
-        "tractor_within_model_range": bool(lift_max < LIFT_OFF_LIMIT_PERCENT),
-        "tractor_note": tractor_range_note(lift_max),
+        "tractor_within_model_range": tractor_range(lift_max)["within_model_range"],
+        "tractor_note": tractor_range(lift_max)["note"],
         "lowest_unfiltered_force_N": float(drive["unfiltered_min_N"].min()),
         "max_lateral_offset_mm": float(drive["lateral_max_mm"].max()),
         "head_half_width_mm": float(drive["head_half_width_mm"].iloc[0]),

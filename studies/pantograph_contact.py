@@ -38,20 +38,13 @@ from catenary.line import ContactLine, load_line
 from catenary.stats import contact_statistics, lateral_statistics
 from eroad.errors import EroadInputError
 
-__all__ = ["STUDY", "REFERENCE_RANGES", "LIFT_OFF_LIMIT_PERCENT", "tractor_range_note",
+__all__ = ["STUDY", "REFERENCE_RANGES", "LIFT_OFF_LIMIT_PERCENT", "tractor_range",
+           "tractor_range_note",
            "contact_drive", "railway_reference",
            "run_pantograph_contact", "plot_contact"]
 
 STUDY = "pantograph_contact"
 
-#: EN 50318:2002 reference-model results (the ranges issue 18 quotes; they are the
-#: standard's, not the 2015 benchmark's): speed [km/h] -> {quantity: (lo, hi)}, forces
-#: [N], uplift at the support [m], loss [%].  Source: Wang, Liu, Mu, Huang, Wang, Gao, "An
-#: Extended Habedank's Equation-Based EMTP Model of Pantograph Arcing Considering
-#: Pantograph-Catenary Interactions and Train Speeds" (IEEE), Table III "Ranges of EN
-#: 50318" (paper text in the public GitHub search index, id 56138154433); the same
-#: 250/300 km/h mean, sd, statistical max/min, uplift and loss ranges are in
-#: github.com/ChandraguptSharma07/faraway backend/sim/validate.py.
 #: share of the tractor drive's output samples in which some tyre would lift off [%] above
 #: which the drive is outside the tractor model's range.  The model's tyres are linear
 #: springs that also pull (vehicles/builder.py: lift-off is not modelled), so while a tyre
@@ -61,6 +54,16 @@ STUDY = "pantograph_contact"
 #: rest on a base motion the model cannot give (ISO class D at 80 km/h: 15 %; the identified
 #: Luliang road of the reference run: 1.2-1.8 % at 80 km/h, from its last 22 m)
 LIFT_OFF_LIMIT_PERCENT = 1.0
+
+
+def tractor_range(lift_off_percent: float) -> dict:
+    """The tractor drive's validity from its tyre lift-off share [%]: the share, the limit,
+    whether it is below :data:`LIFT_OFF_LIMIT_PERCENT`, and :func:`tractor_range_note`'s
+    sentence.  The one place that judges it (the single drive, the grid summary, its figure)."""
+    p = float(lift_off_percent)
+    return {"tyre_lift_off_percent": p, "lift_off_limit_percent": LIFT_OFF_LIMIT_PERCENT,
+            "within_model_range": bool(p < LIFT_OFF_LIMIT_PERCENT),
+            "note": tractor_range_note(p)}
 
 
 def tractor_range_note(lift_off_percent: float) -> str | None:
@@ -78,6 +81,14 @@ def tractor_range_note(lift_off_percent: float) -> str | None:
             "the truck's on this road at this speed: use a smoother road or a lower speed")
 
 
+#: EN 50318:2002 reference-model results (the ranges issue 18 quotes; they are the
+#: standard's, not the 2015 benchmark's): speed [km/h] -> {quantity: (lo, hi)}, forces
+#: [N], uplift at the support [m], loss [%].  Source: Wang, Liu, Mu, Huang, Wang, Gao, "An
+#: Extended Habedank's Equation-Based EMTP Model of Pantograph Arcing Considering
+#: Pantograph-Catenary Interactions and Train Speeds" (IEEE), Table III "Ranges of EN
+#: 50318" (paper text in the public GitHub search index, id 56138154433); the same
+#: 250/300 km/h mean, sd, statistical max/min, uplift and loss ranges are in
+#: github.com/ChandraguptSharma07/faraway backend/sim/validate.py.
 REFERENCE_RANGES: dict[float, dict[str, tuple[float, float]]] = {
     250.0: {"mean": (110.0, 120.0), "sd": (26.0, 31.0), "stat_max": (190.0, 210.0),
             "stat_min": (20.0, 40.0), "actual_max": (175.0, 210.0), "actual_min": (50.0, 75.0),
@@ -137,7 +148,7 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
         ``stats_static`` (dicts), ``lateral`` (dict), ``lateral_series`` (time, offset),
         ``wall`` timings [s], ``config``, ``tractor`` (tyre lift-off share of the drive
         [%], whether it is below :data:`LIFT_OFF_LIMIT_PERCENT`, the sentence of
-        :func:`tractor_range_note`).
+        :func:`tractor_range`).
     """
     from studies.figure11 import (DEFAULT_VEHICLE, drive_base_motion, max_duration,
                                   tractor_variant)
@@ -194,10 +205,7 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
             "stats_static": None if st0 is None else st0.as_dict(),
             "lateral": lat.as_dict(), "lateral_series": (tm, offset, yb),
             "wall": {"vehicle_s": wall_vehicle, "contact_s": wall_contact},
-            "tractor": {"tyre_lift_off_percent": lift_pct,
-                        "lift_off_limit_percent": LIFT_OFF_LIMIT_PERCENT,
-                        "within_model_range": bool(lift_pct < LIFT_OFF_LIMIT_PERCENT),
-                        "note": tractor_range_note(lift_pct)},
+            "tractor": tractor_range(lift_pct),
             "config": {"speed_kmh": float(speed_kmh), "duration_s": dur, "dt_s": dt,
                        "line": str(line), "pantograph": str(pp.name),
                        "n_spans": cl.params.n_spans, "n_dof": int(res.meta["n_dof"]),
