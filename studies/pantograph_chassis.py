@@ -89,7 +89,7 @@ TABLE_COLUMNS: tuple = (
     *(f"dF_rms_{_band_label(b)}Hz_N" for b in FORCE_BANDS),
     *(f"vz_rms_{_band_label(b)}Hz_mm_s" for b in FORCE_BANDS),
     "lateral_max_mm", "lateral_rms_mm", "head_half_width_mm", "lateral_margin_mm",
-    "lateral_beyond_percent", "duration_s", "contact_wall_s", "tyre_lift_off_percent")
+    "lateral_beyond_percent", "duration_s", "contact_wall_s", "tyre_lift_off_percent", "tyres")
 
 
 def code_version() -> str:
@@ -246,6 +246,7 @@ def contact_case(case: dict) -> dict:
             "wall_vehicle_s": float(out["wall"]["vehicle_s"]),
             "wall_contact_s": float(out["wall"]["contact_s"]),
             "tyre_lift_off_percent": float(out["tractor"]["tyre_lift_off_percent"]),
+            "tyres": str(out["tractor"].get("tyres", "bilateral")),
             "time": np.asarray(res.time, dtype=float),
             "force": np.asarray(res["force"], dtype=float),
             "base_z": np.asarray(res["base_z"], dtype=float)}
@@ -331,7 +332,8 @@ def collect(cases: list[dict], results: list[dict], lowpass_hz: float = 20.0):
                     "lateral_beyond_percent": r["lateral_beyond_percent"],
                     "duration_s": r["duration_s"], "contact_wall_s": r["wall_contact_s"],
                     "tyre_lift_off_percent": (float("nan") if is_still else
-                                              float(r.get("tyre_lift_off_percent", float("nan"))))})
+                                              float(r.get("tyre_lift_off_percent", float("nan")))),
+                    "tyres": "" if is_still else str(r.get("tyres", "bilateral"))})
         rows.append(row)
         forces.append(f)
         bases.append(zb)
@@ -493,7 +495,8 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
     lift = (drive["tyre_lift_off_percent"].to_numpy(float) if "tyre_lift_off_percent" in drive
             else np.full(len(drive), np.nan))
     top = 0.96
-    if np.isfinite(lift).any() and not tractor_range(np.nanmax(lift))["within_model_range"]:
+    if np.isfinite(lift).any() and \
+            tractor_range(np.nanmax(lift), _grid_tyres(drive))["within_model_range"] is False:
         fig.text(0.5, 0.918, f"OUTSIDE THE TRACTOR MODEL'S RANGE: a tyre would lift off in up to "
                  f"{np.nanmax(lift):.1f} % of the drive (limit {LIFT_OFF_LIMIT_PERCENT:g} %).\nThe "
                  "model's tyres stay on the road, so these statistics are not the truck's.",
@@ -502,6 +505,14 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
     fig.tight_layout(rect=(0, 0, 1, top))
     from studies.pantograph_contact import save_png_pdf
     return save_png_pdf(fig, path, dpi=110)
+
+
+def _grid_tyres(drive) -> str:
+    """The tyre model of a grid's drives: ``"unilateral"`` only if every drive says so (grids
+    made before the column existed were driven with bilateral tyres)."""
+    if "tyres" not in drive:
+        return "bilateral"
+    return "unilateral" if (drive["tyres"].astype(str) == "unilateral").all() else "bilateral"
 
 
 def _summary(table, cases, sweep, road_label: str) -> dict:
@@ -533,8 +544,9 @@ def _summary(table, cases, sweep, road_label: str) -> dict:
         "lowest_sd": pick(drive["sd_N"].idxmin()), "highest_sd": pick(drive["sd_N"].idxmax()),
         "max_loss_percent": float(drive["loss_percent"].max()),
         "max_tyre_lift_off_percent": lift_max,
-        "tractor_within_model_range": tractor_range(lift_max)["within_model_range"],
-        "tractor_note": tractor_range(lift_max)["note"],
+        "tractor_tyres": _grid_tyres(drive),
+        "tractor_within_model_range": tractor_range(lift_max, _grid_tyres(drive))["within_model_range"],
+        "tractor_note": tractor_range(lift_max, _grid_tyres(drive))["note"],
         "lowest_unfiltered_force_N": float(drive["unfiltered_min_N"].min()),
         "max_lateral_offset_mm": float(drive["lateral_max_mm"].max()),
         "head_half_width_mm": float(drive["head_half_width_mm"].iloc[0]),

@@ -128,29 +128,40 @@ def test_cli_grid_needs_a_road(capsys, tmp_path):
 
 def test_tractor_lift_off_reported_per_configuration(tiny):
     """The tractor's tyre lift-off share is a column (NaN for the still base, whose drive does
-    not move the pantograph) and the summary's worst case, judged against the limit."""
-    from studies.pantograph_contact import LIFT_OFF_LIMIT_PERCENT
-
+    not move the pantograph) and the summary's worst case; the drives run with unilateral
+    tyres (a column), for which lift-off is modelled and the drive is within range."""
     s, t, _, _ = tiny
     drive = t[t["base"] == "drive"]
     assert drive["tyre_lift_off_percent"].notna().all()
     assert t[t["base"] == "still"]["tyre_lift_off_percent"].isna().all()
+    assert (drive["tyres"] == "unilateral").all()
     assert s["max_tyre_lift_off_percent"] == pytest.approx(drive["tyre_lift_off_percent"].max())
-    assert s["tractor_within_model_range"] == (s["max_tyre_lift_off_percent"] < LIFT_OFF_LIMIT_PERCENT)
+    assert s["tractor_tyres"] == "unilateral" and s["tractor_within_model_range"] is True
 
 
 def test_tractor_range_note_thresholds():
-    from studies.pantograph_contact import LIFT_OFF_LIMIT_PERCENT, tractor_range_note
+    """Bilateral tyres (older drives, or forced): the 1 % limit; unilateral tyres: lift-off is
+    modelled, reported, never out of range; an unknown share is said to be unknown."""
+    from studies.pantograph_contact import LIFT_OFF_LIMIT_PERCENT, tractor_range, tractor_range_note
 
-    assert tractor_range_note(0.0) is None and tractor_range_note(float("nan")) is None
-    assert "isolated peaks" in tractor_range_note(0.2)
-    assert tractor_range_note(LIFT_OFF_LIMIT_PERCENT).startswith("OUTSIDE THE TRACTOR MODEL'S RANGE")
+    for tyres in ("bilateral", "unilateral"):
+        assert tractor_range_note(0.0, tyres) is None
+        assert "unknown" in tractor_range_note(float("nan"), tyres)
+        assert tractor_range(float("nan"), tyres)["within_model_range"] is None
+    assert "isolated peaks" in tractor_range_note(0.2, "bilateral")
+    assert tractor_range_note(LIFT_OFF_LIMIT_PERCENT, "bilateral").startswith(
+        "OUTSIDE THE TRACTOR MODEL'S RANGE")
+    assert tractor_range(LIFT_OFF_LIMIT_PERCENT, "bilateral")["within_model_range"] is False
+    assert tractor_range(0.5, "bilateral")["within_model_range"] is True
+    assert tractor_range(30.0, "unilateral")["within_model_range"] is True
+    assert "modelled" in tractor_range_note(30.0, "unilateral")
 
 
-def test_rough_road_drive_is_flagged_outside_the_tractor_range(tmp_path):
+def test_rough_road_drive_lifts_off_with_unilateral_tyres(tmp_path):
     """ISO class E at 80 km/h: the e-tractor's rear tyres (16 kN static each) see dynamic
-    loads of about 20 kN sd, so a tyre would lift off in far more than 1 % of the samples
-    (67 % over 21 s measured); the drive must say it is outside the model's range."""
+    loads of about 20 kN sd, so tyres leave the road in far more than 1 % of the samples
+    (67 % over 21 s measured).  The drive runs with unilateral tyres, reports the share and
+    says it is modelled."""
     from roadlib.surface import RoadSurface
     from studies.pantograph_contact import contact_drive
 
@@ -159,5 +170,6 @@ def test_rough_road_drive_is_flagged_outside_the_tractor_range(tmp_path):
                  "--out", str(road)]) == 0
     out = contact_drive(RoadSurface.load(road), speed_kmh=80.0, duration=4.0, compare_static=False)
     tr = out["tractor"]
-    assert tr["tyre_lift_off_percent"] > 5.0 and not tr["within_model_range"]
-    assert tr["note"].startswith("OUTSIDE THE TRACTOR MODEL'S RANGE")
+    assert tr["tyres"] == "unilateral"
+    assert tr["tyre_lift_off_percent"] > 5.0 and tr["within_model_range"] is True
+    assert "modelled" in tr["note"]

@@ -102,13 +102,20 @@ def test_leaf_friction_raises_body_acceleration_at_small_amplitudes(roads, base)
 
 def test_bump_stop_raises_peaks_at_large_amplitudes(roads, base):
     """Bump stops 20 mm above static: on a class E road (suspension peaks ~0.1 m) they
-    clip the compression peaks (max below 0.75x) and make body acceleration
-    heavy-tailed (excess kurtosis up by more than 0.4, measured -0.2 -> 0.6); on a
-    class A road (peaks 6 mm) nothing changes (RMS within 0.5 %)."""
+    clip the compression peaks (max below 0.75x; measured 0.66x) and, with tyres that stay
+    on the road, make body acceleration heavy-tailed (excess kurtosis up by more than 0.4,
+    measured -0.69 -> -0.14).  On this road some tyre is off the ground in 80 % of the
+    samples; with the (default) one-sided tyres the lift-off is a nonlinearity of its own
+    and the kurtosis of body_acc_3L no longer moves (-0.44 -> -0.45; at axle 1 it does,
+    -0.01 -> 0.49), so the heavy tail is checked with bilateral tyres, which isolate the
+    effect.  On a class A road (peaks 6 mm) nothing changes (RMS within 0.5 %)."""
     b = base["E"].channels
     e = simulate("dump_truck_8x4", roads["E"], V, T, effects={"bump_stop": 0.02}).channels
     assert e["susp_disp_3L"].max() < 0.75 * b["susp_disp_3L"].max()
-    assert st.kurtosis(e["body_acc_3L"]) > st.kurtosis(b["body_acc_3L"]) + 0.4
+    bb = simulate("dump_truck_8x4", roads["E"], V, T, tyres="bilateral").channels
+    eb = simulate("dump_truck_8x4", roads["E"], V, T, effects={"bump_stop": 0.02},
+                  tyres="bilateral").channels
+    assert st.kurtosis(eb["body_acc_3L"]) > st.kurtosis(bb["body_acc_3L"]) + 0.4
     a = simulate("dump_truck_8x4", roads["A"], V, T, effects={"bump_stop": 0.02}).channels
     assert np.std(a["body_acc_3L"]) == pytest.approx(np.std(base["A"].channels["body_acc_3L"]), rel=0.005)
 

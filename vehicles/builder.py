@@ -46,8 +46,9 @@ road; the vehicle does not move along x: the road moves under it):
   :meth:`VehicleModel.road_input_matrix` at static equilibrium), set with a single
   call per step.  This is exact for the linear (bilateral) tyre up to the
   rotation of the axles from static (the force directions are frozen at
-  equilibrium; axle rotations are ~1e-3 rad); tyre lift-off is not modelled
-  (``SimResult.meta`` reports when a tyre would have lifted);
+  equilibrium; axle rotations are ~1e-3 rad).  A tyre off the road carries no
+  force: :mod:`vehicles.tyre_contact` adds, per step, the force that cancels the
+  linear tyre's pull (:func:`vehicles.simulate.simulate`, ``tyres="unilateral"``);
 * DCDC block (tractor): a rigid body on a 6-DOF mount spring-damper equivalent to
   four mounts at the corners of its base;
 * surge: wheels roll freely, so nothing ties the vehicle to the road along x but

@@ -40,6 +40,7 @@ from vehicles.effects import EFFECTS, resolve_effects
 from vehicles.effects.base import Effect, EffectContext
 from vehicles.params import VehicleParams, load_vehicle
 from vehicles.result import SimResult, unit_of
+from vehicles.tyre_contact import TYRE_CONTACTS, tyre_forces, unilateral_prestep
 
 #: frame stiffness factor above which Newton iterations are switched on: with the
 #: Jacobian factorised once and one solve per step, joints ~1e4 times stiffer than
@@ -301,7 +302,7 @@ def _small_rotation(R, R0):
 def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effects=None,
              dt: float | None = None, fs_out: float = 200.0, x_start: float | None = None,
              y_offset: float = 0.0, seed: int | None = None, frame_segments: int | None = None,
-             newton: bool | None = None) -> SimResult:
+             newton: bool | None = None, tyres: str = "unilateral") -> SimResult:
     """Simulate a vehicle driving over a road.
 
     The linear model (no nonlinear effect) is integrated with one linear solve per
@@ -311,6 +312,12 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     with Newton iterations whose iterations fail to converge (stiff stick-slip
     friction) is repeated with the time step halved, at most :data:`MAX_DT_HALVINGS`
     times (``meta["dt_halvings"]``; ``meta["dt"]`` is the step used).
+
+    Tyres are unilateral by default: a tyre off the road carries no force
+    (:mod:`vehicles.tyre_contact`).  The drive is first run with linear tyres, which is
+    exact while every tyre presses on the road; if a tyre would have pulled at any output
+    sample, the drive is run again with the one-sided correction
+    (``meta["tyre_contact_run"]`` is then ``"unilateral"``, else ``"linear"``).
 
     Parameters
     ----------
@@ -344,6 +351,9 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     newton : bool, optional
         Force (True) or suppress (False) Newton iterations; default: only with
         nonlinear effects.
+    tyres : {"unilateral", "bilateral"}
+        ``"bilateral"``: linear tyres that also pull (the model before lift-off was
+        modelled; the linear frequency response's assumption).
 
     Returns
     -------
@@ -358,13 +368,30 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
         The solver failed or diverged; the message names the simulated time and the
         likely cause.
     """
+    if tyres not in TYRE_CONTACTS:
+        raise EroadInputError(f"tyres must be one of {', '.join(TYRE_CONTACTS)}, got {tyres!r}")
     kw = dict(chassis=chassis, effects=effects, fs_out=fs_out, x_start=x_start,
               y_offset=y_offset, seed=seed, frame_segments=frame_segments)
+    wall0, cpu0 = _time.perf_counter(), _time.process_time()
+    res = _simulate_retrying(vehicle, road, speed, duration, dt, newton, False, kw)
+    if tyres == "unilateral" and res.meta["tyre_pull_fraction"] > 0:
+        res = _simulate_retrying(vehicle, road, speed, duration, dt, newton, True, kw)
+        res.meta["wall_s"] = _time.perf_counter() - wall0
+        res.meta["cpu_s"] = _time.process_time() - cpu0
+        res.meta["realtime_factor"] = res.meta["duration"] / res.meta["wall_s"]
+        res.meta["cpu_realtime_factor"] = res.meta["duration"] / res.meta["cpu_s"]
+    res.meta["tyres"] = tyres
+    return res
+
+
+def _simulate_retrying(vehicle, road, speed, duration, dt, newton, unilateral, kw) -> SimResult:
+    """:func:`_simulate` with the Newton fallback and the time-step halvings."""
     wall0, cpu0 = _time.perf_counter(), _time.process_time()
     fallback, halvings, dt_try, newton_try = False, 0, dt, newton
     while True:
         try:
-            res = _simulate(vehicle, road, speed, duration, newton=newton_try, dt=dt_try, **kw)
+            res = _simulate(vehicle, road, speed, duration, newton=newton_try, dt=dt_try,
+                            unilateral=unilateral, **kw)
             break
         except SimulationError as exc:
             if newton_try is None and not getattr(exc, "newton", True):
@@ -400,7 +427,7 @@ def _simulate(*args, **kw) -> SimResult:
 
 
 def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_start,
-                   y_offset, seed, frame_segments, newton, built) -> SimResult:
+                   y_offset, seed, frame_segments, newton, unilateral, built) -> SimResult:
     wall0 = _time.perf_counter()
     cpu0 = _time.process_time()
     import exudyn as exu
@@ -510,6 +537,9 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
         set_obj(inj, "forceVector", Q[int(t * inv_dt + 0.5)])
         return True
 
+    off = None
+    if unilateral:
+        prestep, off = unilateral_prestep(model, Q, B, zr, zr_t, kc, cc, dt)
     model.mbs.SetPreStepUserFunction(prestep)
     nonlinear = any(EFFECTS[n].nonlinear for n in eff) if newton is None else bool(newton)
     if newton is None and ctx.chassis == "flexible" and ctx.stiffness_factor > STIFF_FRAME_NEWTON:
@@ -621,15 +651,20 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
         exc.newton, exc.dt = nonlinear, dt
         raise
 
-    # tyre forces (dynamic part) and lift-off
+    # tyre forces (dynamic part) and lift-off: a linear tyre "pulls" where it would carry
+    # tension or press while off the road (what the unilateral correction changes)
     k_out = np.arange(n_out) * n_sub
     zr_o, zr_t_o = zr[k_out], zr_t[k_out]
     zc_t = np.gradient(zc, t_out, axis=0)
-    f_dyn = kc * (zr_o - zc) + cc * (zr_t_o - zc_t)
     f_static = model.static_tyre_loads()
-    lift = np.any(f_static[None, :] + f_dyn < 0, axis=1)
+    defl = f_static / kc + zr_o - zc
+    rate = zr_t_o - zc_t
+    f_lin = kc * defl + cc * rate
+    f_uni = tyre_forces(defl, rate, kc, cc)
+    pull = np.any(f_uni != f_lin, axis=1)
+    lift = np.any(f_uni <= 0.0, axis=1)
     extra["road_z"] = zr_o
-    extra["tyre_force"] = f_dyn
+    extra["tyre_force"] = (f_uni if unilateral else f_lin) - f_static
 
     meta_eff = {n: dict(p) for n, p in eff.items()}
     for name, p in eff.items():
@@ -652,6 +687,9 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
         "speed_mean": float(np.mean(profile.speed(time))), "distance_m": float(s_steps[-1]),
         "x_start": x_start, "y_offset": float(y_offset), "seed": seed,
         "tyre_lift_off_fraction": float(lift.mean()),
+        "tyre_pull_fraction": float(pull.mean()),
+        "tyre_contact_run": "unilateral" if unilateral else "linear",
+        "tyre_off_steps": int(off["steps_off"]) if off is not None else 0,
         "road": {k: v for k, v in (getattr(road, "meta", {}) or {}).items()
                  if isinstance(v, (int, float, str, bool))},
         "exudyn_version": exu.__version__,
