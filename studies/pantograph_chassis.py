@@ -502,6 +502,11 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
                  "model's tyres stay on the road, so these statistics are not the truck's.",
                  ha="center", va="bottom", color="C3", fontsize=9, fontweight="bold")
         top = 0.91
+    elif np.isfinite(lift).any() and np.nanmax(lift) > 0:
+        fig.text(0.5, 0.925, f"tractor: a tyre was off the road in up to {np.nanmax(lift):.1f} % of "
+                 "the drive's samples (one-sided tyres: modelled)", ha="center", va="bottom",
+                 color="0.35", fontsize=8.5)
+        top = 0.925
     fig.tight_layout(rect=(0, 0, 1, top))
     from studies.pantograph_contact import save_png_pdf
     return save_png_pdf(fig, path, dpi=110)
