@@ -73,6 +73,9 @@ from eroad.errors import EroadInputError
 
 #: ISO 8608 road shape kept fixed by the cheap road fit
 ROAD_W, ROAD_NMIN, ROAD_NMAX = 2.0, 0.1, 5.0
+#: a window's runs skip the linear first pass of the one-sided tyres when the nominal run had
+#: a tyre off the road inside it or this long before it [s] (its run-in)
+LIFT_HINT_MARGIN_S = 2.0
 #: reference level of the first (nominal) simulation [m^3] (class C mean)
 GQ_REF = 256e-6
 #: run-in simulated and discarded before every window [s]
@@ -311,10 +314,17 @@ class TruckModel:
     nmin: np.ndarray | None = None
     nmax: np.ndarray | None = None
     _roads: dict = field(default_factory=dict, repr=False, compare=False)
+    #: record times [s] at which the nominal run of the whole record had a tyre off the road
+    #: (set by :func:`context`): runs of windows that contain one skip the linear first pass
+    #: (``vehicles.simulate(lift_off_expected=True)``, same physics, less time).  Fixed before
+    #: the model is sent to the workers, so which path a run takes does not depend on them.
+    lift_times: np.ndarray | None = None
+    _last_lift_times: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def __getstate__(self):
         d = dict(self.__dict__)
         d["_roads"] = {}
+        d["_last_lift_times"] = None
         return d
 
     @property
@@ -407,8 +417,12 @@ class TruckModel:
         road = self._road(t0, t1, seed, gq)
         prof = SpeedProfile(tau, v)
         dur = (tau.size - 1) / self.fs
+        lt = self.lift_times
+        expected = lt is not None and bool(np.any((lt >= t0 - LIFT_HINT_MARGIN_S) & (lt < t1)))
         res = simulate(self._vp(), road, prof, dur, effects=effects or None, x_start=x_start,
-                       fs_out=self.fs, seed=int(seed))
+                       fs_out=self.fs, seed=int(seed), lift_off_expected=expected)
+        off = np.asarray(res.extra.get("tyre_off", np.zeros(0, bool)))[n_run:n_run + n]
+        self._last_lift_times = float(t0) + np.nonzero(off)[0] / self.fs
         out = {}
         for c in self.channels:
             x = np.asarray(res.channels[c], float)[n_run:n_run + n]
@@ -1092,6 +1106,7 @@ def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fi
         raise EroadInputError(f"road_fit must be 'levels' or 'inverse', got {road_fit!r}")
     T = sig.time.size / sig.fs
     simc = model.run({}, 0.0, T, seed + 1)
+    model.lift_times = model._last_lift_times
     model.noise = noise_from_residual(sig, simc)
     segs = [(f"S{k + 1}", float(bounds[k]), float(bounds[k + 1])) for k in range(len(bounds) - 1)]
     return Context(model, calib, held, edges, bounds, cal_edges, simc, segs,

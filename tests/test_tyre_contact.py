@@ -109,3 +109,26 @@ def test_lift_off_response_matches_the_independent_truck(bump_drives):
         moved.append(abs(np.log(rms(ex.channels[ch]) / rms(bil.channels[ch]))))
     # the check can fail: without lift-off eroad would miss the independent truck by more
     assert max(moved) > 0.2
+
+
+def test_expected_lift_off_skips_the_linear_run_with_the_same_result(bump_drives):
+    """``lift_off_expected=True`` runs the one-sided correction at once: the result equals the
+    two-pass drive's to the last bit (the corrected run never depends on the linear one), so a
+    caller's hint changes the cost only."""
+    two = bump_drives[("ex", 1.0)]
+    one = simulate("dump_truck_8x4", bump_road(0.12), 15.0, 6.0, x_start=20.0,
+                   lift_off_expected=True)
+    assert one.meta["tyre_contact_run"] == "unilateral"
+    for ch in CHANNELS:
+        assert np.array_equal(one.channels[ch], two.channels[ch]), ch
+    # and without lift-off the direct run is the linear one (the correction never acts).  The
+    # 2 cm bump of test_no_lift_off_is_the_linear_run is not used here: its vertical edges
+    # (2 cm over one 2 cm grid cell, 15 m/s) drive the tyre damper to pull for 2 time steps
+    # between output samples, which the direct run corrects and the two-pass run, whose
+    # trigger looks at the output samples, does not (2 % of a channel's peak)
+    flat = bump_road(0.01)
+    a = simulate("dump_truck_8x4", flat, 15.0, 4.0, x_start=20.0, lift_off_expected=True)
+    b = simulate("dump_truck_8x4", flat, 15.0, 4.0, x_start=20.0)
+    assert a.meta["tyre_off_steps"] == 0
+    for ch in CHANNELS:
+        assert np.array_equal(a.channels[ch], b.channels[ch]), ch

@@ -302,7 +302,8 @@ def _small_rotation(R, R0):
 def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effects=None,
              dt: float | None = None, fs_out: float = 200.0, x_start: float | None = None,
              y_offset: float = 0.0, seed: int | None = None, frame_segments: int | None = None,
-             newton: bool | None = None, tyres: str = "unilateral") -> SimResult:
+             newton: bool | None = None, tyres: str = "unilateral",
+             lift_off_expected: bool = False) -> SimResult:
     """Simulate a vehicle driving over a road.
 
     The linear model (no nonlinear effect) is integrated with one linear solve per
@@ -317,7 +318,10 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     (:mod:`vehicles.tyre_contact`).  The drive is first run with linear tyres, which is
     exact while every tyre presses on the road; if a tyre would have pulled at any output
     sample, the drive is run again with the one-sided correction
-    (``meta["tyre_contact_run"]`` is then ``"unilateral"``, else ``"linear"``).
+    (``meta["tyre_contact_run"]`` is then ``"unilateral"``, else ``"linear"``).  The
+    corrected run looks at the tyres from the start, so it does not depend on the linear
+    run: ``lift_off_expected=True`` skips the linear run and gives the same result (callers
+    that drive one road many times, as the diagnosis does, save the first run).
 
     Parameters
     ----------
@@ -354,6 +358,9 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     tyres : {"unilateral", "bilateral"}
         ``"bilateral"``: linear tyres that also pull (the model before lift-off was
         modelled; the linear frequency response's assumption).
+    lift_off_expected : bool
+        With unilateral tyres: run with the one-sided correction at once (no linear run
+        first).  Same result; faster when a tyre does lift off, slower when none does.
 
     Returns
     -------
@@ -373,8 +380,9 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     kw = dict(chassis=chassis, effects=effects, fs_out=fs_out, x_start=x_start,
               y_offset=y_offset, seed=seed, frame_segments=frame_segments)
     wall0, cpu0 = _time.perf_counter(), _time.process_time()
-    res = _simulate_retrying(vehicle, road, speed, duration, dt, newton, False, kw)
-    if tyres == "unilateral" and res.meta["tyre_pull_fraction"] > 0:
+    direct = tyres == "unilateral" and bool(lift_off_expected)
+    res = _simulate_retrying(vehicle, road, speed, duration, dt, newton, direct, kw)
+    if tyres == "unilateral" and not direct and res.meta["tyre_pull_fraction"] > 0:
         res = _simulate_retrying(vehicle, road, speed, duration, dt, newton, True, kw)
         res.meta["wall_s"] = _time.perf_counter() - wall0
         res.meta["cpu_s"] = _time.process_time() - cpu0
@@ -385,7 +393,8 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
 
 
 def _simulate_retrying(vehicle, road, speed, duration, dt, newton, unilateral, kw) -> SimResult:
-    """:func:`_simulate` with the Newton fallback and the time-step halvings."""
+    """:func:`_simulate` with the Newton fallback and the time-step halvings; ``unilateral``:
+    with the one-sided tyre correction."""
     wall0, cpu0 = _time.perf_counter(), _time.process_time()
     fallback, halvings, dt_try, newton_try = False, 0, dt, newton
     while True:
@@ -665,6 +674,7 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
     lift = np.any(f_uni <= 0.0, axis=1)
     extra["road_z"] = zr_o
     extra["tyre_force"] = (f_uni if unilateral else f_lin) - f_static
+    extra["tyre_off"] = lift
 
     meta_eff = {n: dict(p) for n, p in eff.items()}
     for name, p in eff.items():

@@ -75,34 +75,42 @@ def unilateral_prestep(model, Q, B, zr, zr_t, k, c, dt):
     mbs = model.mbs
     sd = mbs.systemData
     idx = model.coordinate_indices()
+    n = sd.ODE2Size()
     rows = np.concatenate([idx[b.name] for b in model.axles])
-    Bt = np.ascontiguousarray(B.T)
-    q0 = np.asarray(sd.GetODE2Coordinates())[rows].copy()
+    # the contact height and rate at the step's end from q, v, a over all coordinates:
+    # [z; dz/dt] = P @ [q, v, a] + p0, with z = zc0 + B^T (q - q0) + dt v + dt^2 a / 2
+    Bt = np.zeros((B.shape[1], n))
+    Bt[:, rows] = B.T
+    nc = B.shape[1]
+    P = np.zeros((2 * nc, 3 * n))
+    P[:nc, :n], P[:nc, n:2 * n], P[:nc, 2 * n:] = Bt, dt * Bt, 0.5 * dt * dt * Bt
+    P[nc:, n:2 * n], P[nc:, 2 * n:] = Bt, dt * Bt
+    q0 = np.asarray(sd.GetODE2Coordinates(), float).copy()
     # contact height above the flat-road static state at the start (exact kinematics)
     zc0 = np.array([model.point_position(model.axles[ct.axle].name, ct.local)[2]
                     - _static_z(model, ct) for ct in model.contacts])
-    d_static = model.static_tyre_loads() / k
+    # deflection d = d_static + zr - z = base + zr - (P q)[:nc]
+    base = model.static_tyre_loads() / k - zc0 + Bt @ q0
     n_last = zr.shape[0] - 1
-    inv_dt, h, h2 = 1.0 / dt, dt, 0.5 * dt * dt
+    inv_dt = 1.0 / dt
     set_obj = mbs.SetObjectParameter
     inj = model.injector
     get_q, get_v, get_a = sd.GetODE2Coordinates, sd.GetODE2Coordinates_t, sd.GetODE2Coordinates_tt
+    concat = np.concatenate
     counter = {"steps_off": 0}
 
     def prestep(mbs_, t):   # t is the end of the step
         i = int(t * inv_dt + 0.5)
         j = i if i <= n_last else n_last
-        v = Bt @ np.asarray(get_v())[rows]
-        a = Bt @ np.asarray(get_a())[rows]
-        z = zc0 + Bt @ (np.asarray(get_q())[rows] - q0) + h * v + h2 * a
-        d = d_static + zr[j] - z
-        f_lin = k * d + c * (zr_t[j] - v - h * a)
-        corr = np.where(d > 0.0, np.maximum(f_lin, 0.0), 0.0) - f_lin
-        if corr.any():
-            counter["steps_off"] += 1
-            set_obj(inj, "forceVector", Q[i] + B @ corr)
-        else:
+        zz = P @ concat((get_q(), get_v(), get_a()))
+        d = base + zr[j] - zz[:nc]
+        f_lin = k * d + c * (zr_t[j] - zz[nc:])
+        if d.min() > 0.0 and f_lin.min() >= 0.0:
             set_obj(inj, "forceVector", Q[i])
+            return True
+        counter["steps_off"] += 1
+        corr = np.where(d > 0.0, np.maximum(f_lin, 0.0), 0.0) - f_lin
+        set_obj(inj, "forceVector", Q[i] + B @ corr)
         return True
 
     return prestep, counter
