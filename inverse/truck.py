@@ -189,9 +189,13 @@ class TruckSimulator:
         if self.dt is not None:
             kw["dt"] = self.dt
         t_sim, v_sim = lay["t_sim"], lay["v_sim"]
+        # one-sided tyres with the correction on from the start (lift_off_expected): the same
+        # result as the two-pass drive, and one run instead of two on a road where a tyre
+        # leaves the ground (every run of the embedded record does, 0.3-0.7 % of its samples:
+        # 0.48 s instead of 0.85 s; a road where none does pays 0.48 s instead of 0.35 s)
         res = simulate(self.vehicle, road, speed=SpeedProfile(t_sim, v_sim), duration=float(t_sim[-1]),
                        chassis=self.chassis, effects=self.effects or None, fs_out=lay["fs"],
-                       x_start=lay["x_front0"], y_offset=0.0, seed=0, **kw)
+                       x_start=lay["x_front0"], y_offset=0.0, seed=0, lift_off_expected=True, **kw)
         n_run, n = lay["n_runin"], self.time.size
         out = {}
         for c in self.channels:
