@@ -998,16 +998,23 @@ def read_truth(dataset) -> dict:
     return truth
 
 
+#: the truth model's version, part of the default dataset's cache key: change it whenever
+#: the simulation of a scenario changes its output (a cached record made by an older model
+#: must not be served as the embedded dataset).  2026-11-25: one-sided tyres.
+TRUTH_MODEL_VERSION = "2026-11-25 one-sided tyres"
+
+
 def _scenario_key() -> str:
-    """Ten hex digits of the default scenario as resolved: the cache folder's name carries
-    it, so a changed scenario file is never served from a stale cache."""
+    """Ten hex digits of the default scenario as resolved and of :data:`TRUTH_MODEL_VERSION`:
+    the cache folder's name carries it, so a changed scenario file or truth model is never
+    served from a stale cache."""
     import hashlib
 
     import tomli_w
 
     cfg, path = load_scenario(DEFAULT_SCENARIO)
     text = tomli_w.dumps(_jsonable(resolve_scenario(cfg, DEFAULT_SEED, src=path)))
-    return hashlib.sha256(text.encode()).hexdigest()[:10]
+    return hashlib.sha256((TRUTH_MODEL_VERSION + "\n" + text).encode()).hexdigest()[:10]
 
 
 def default_dataset(path=None) -> Path:
