@@ -798,6 +798,8 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
         res = simulate(vp, road, speed=SpeedProfile(plan["t_sim"], plan["v_sim"]),
                        duration=duration_sim, fs_out=fs, x_start=plan["x_front0"], y_offset=0.0,
                        seed=_int_seed(seed, STREAM_VEHICLE), **_sim_kwargs(cfg))
+    truth_tyres = ("unilateral" if model.tyres["liftoff"] else "bilateral") if independent \
+        else str(res.meta.get("tyres", "unilateral"))
     tsim = np.asarray(res.time, float)
     idx = np.searchsorted(tsim, n_run / fs - 0.25 / fs)
     if tsim.size - idx < n_rec:
@@ -888,6 +890,12 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
         "segments": [{k: s[k] for k in ("t_start", "t_end", "proportion", "Gq_n0", "w", "nmin",
                                          "nmax", "label", "x_start", "x_end")} for s in segments],
         "effects": cfg["truth"]["effects"], "chassis": cfg["truth"]["chassis"],
+        # what made the drive: the truth model, its tyres and how often a tyre left the road
+        "truth_model": {"model": "independent" if independent else "exudyn",
+                        "version": TRUTH_MODEL_VERSION,
+                        "tyres": truth_tyres,
+                        "tyre_lift_off_fraction": float(res.meta.get("tyre_lift_off_fraction",
+                                                                     float("nan")))},
     }
     if window is not None:
         summary["record_s"] = [start, start + n_rec / fs]
@@ -1001,7 +1009,7 @@ def read_truth(dataset) -> dict:
 #: the truth model's version, part of the default dataset's cache key: change it whenever
 #: the simulation of a scenario changes its output (a cached record made by an older model
 #: must not be served as the embedded dataset).  2026-11-25: one-sided tyres.
-TRUTH_MODEL_VERSION = "2026-11-25 one-sided tyres"
+TRUTH_MODEL_VERSION = "2026-11-25 one-sided tyres; truth_model in the truth summary"
 
 
 def _scenario_key() -> str:

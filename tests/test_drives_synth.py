@@ -192,6 +192,9 @@ def test_default_dataset_cache_is_keyed_by_the_scenario(tmp_path, monkeypatch, s
     assert synth._scenario_key() != k1
     monkeypatch.setattr(synth, "DEFAULT_SCENARIO", str(short_cfg))
     assert synth._scenario_key() == k1
+    # and a new truth model (its output changed) is a new key too
+    monkeypatch.setattr(synth, "TRUTH_MODEL_VERSION", synth.TRUTH_MODEL_VERSION + " changed")
+    assert synth._scenario_key() != k1
 
 
 def test_time_proportions_become_road_lengths():
@@ -283,6 +286,12 @@ def test_dataset_is_valid_and_truth_complete(short_ds):
     road = RoadSurface.load(truth["road_file"])
     assert road.x_max == pytest.approx(truth["road"]["length_m"], abs=0.05)
     assert len(truth["junctions"]) == 1
+    # the truth says which model made it and how its tyres behaved
+    import json
+
+    tm = json.loads((short_ds / "truth" / "summary.json").read_text())["truth_model"]
+    assert tm["model"] == "exudyn" and tm["tyres"] == "unilateral"
+    assert tm["version"] == synth.TRUTH_MODEL_VERSION and 0.0 <= tm["tyre_lift_off_fraction"] <= 1.0
     # meta.toml gives nothing of the truth away
     meta = (short_ds / "meta.toml").read_text()
     assert "Gq" not in meta and "effect" not in meta
