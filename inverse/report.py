@@ -214,9 +214,9 @@ def write_table(df: pd.DataFrame, stem: Path, floatfmt: str = ".4g", note: str =
     return [stem.with_suffix(".csv"), stem.with_suffix(".md")]
 
 
-def write_figures(fig_dir: Path, *, time, measured: dict, simulated: dict, segmentation, seg_signal,
-                  title: str = "") -> list:
-    """Figures 6, 8 and 9 as PNG and PDF.
+def write_figures(fig_dir: Path, *, time, measured: dict, simulated: dict | None, segmentation,
+                  seg_signal, title: str = "", which: str = "689") -> list:
+    """Figures 6, 8 and 9 as PNG and PDF (each drawn once, saved in both formats).
 
     Parameters
     ----------
@@ -228,6 +228,9 @@ def write_figures(fig_dir: Path, *, time, measured: dict, simulated: dict, segme
     seg_signal : (N,) array
         The displacement shown in Figure 6 [m].
     title : str
+    which : str
+        The figures to draw: any of "6", "8", "9" (Figure 6 needs the fit only, so it can be
+        drawn before the realisation is chosen; ``simulated`` may then be None).
 
     Returns
     -------
@@ -238,16 +241,25 @@ def write_figures(fig_dir: Path, *, time, measured: dict, simulated: dict, segme
 
     fig_dir = Path(fig_dir)
     fig_dir.mkdir(parents=True, exist_ok=True)
-    chans = [c for c in ("susp_disp_3L", "susp_disp_3R") if c in measured and c in simulated]
+    chans = [c for c in ("susp_disp_3L", "susp_disp_3R") if c in measured and c in (simulated or {})]
+
+    def both(stem):
+        return [fig_dir / f"{stem}.png", fig_dir / f"{stem}.pdf"]
+
     out = []
-    for ext in ("png", "pdf"):
-        out.append(plot_segmentation(segmentation, time, seg_signal, fig_dir / f"figure6_segmentation.{ext}",
-                                     title=f"Figure 6: segmentation {title}"))
-        out.append(plot_time_compare(time, measured, simulated, chans, fig_dir / f"figure8_time_compare.{ext}",
-                                     title=f"Figure 8: measured vs simulated, axle 3 {title}\n"
-                                           "simulated on a random-phase road of the fitted spectra: "
-                                           "not a phase-true (waveform) comparison"))
-        out.append(plot_amplitude_distributions(measured, simulated, chans,
-                                                fig_dir / f"figure9_amplitude_distributions.{ext}",
-                                                title=f"Figure 9: amplitude distributions {title}"))
+    if "6" in which:
+        plot_segmentation(segmentation, time, seg_signal, both("figure6_segmentation"),
+                          title=f"Figure 6: segmentation {title}")
+        out += both("figure6_segmentation")
+    if "8" in which:
+        plot_time_compare(time, measured, simulated, chans, both("figure8_time_compare"),
+                          title=f"Figure 8: measured vs simulated, axle 3 {title}\n"
+                                "simulated on a random-phase road of the fitted spectra: "
+                                "not a phase-true (waveform) comparison")
+        out += both("figure8_time_compare")
+    if "9" in which:
+        plot_amplitude_distributions(measured, simulated, chans,
+                                     both("figure9_amplitude_distributions"),
+                                     title=f"Figure 9: amplitude distributions {title}")
+        out += both("figure9_amplitude_distributions")
     return [Path(p) for p in out]

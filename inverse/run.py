@@ -293,7 +293,9 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                 bar.set_description("invert: report")
             fig_kw = dict(time=time, measured=chans, simulated=sel["simulated"], segmentation=inv.segmentation,
                           seg_signal=chans["susp_disp_3L"], title=f"({drive.name})")
-            figures = pool.submit(write_figures, tmp / "figures", **fig_kw) if pool is not None else None
+            # Figures 8 and 9 need the chosen realisation: one pool worker each
+            figures = ([pool.submit(write_figures, tmp / "figures", which=w, **fig_kw) for w in "89"]
+                       if pool is not None else None)
             return sel, fig_kw, figures
 
         # the road model of each segment, one ISO slope or two (inverse.road_model), first:
@@ -309,6 +311,13 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             # With a pool, the selection (and then the figures) run from a thread of this process
             # on the pool's workers, while this process computes what needs the fit only: the
             # lateral-structure sensitivity.
+            # Figure 6 needs the fit only: drawn now (in a pool worker: the selection leaves the
+            # workers mostly idle, its 3 simulations aside)
+            fig6_kw = dict(time=time, measured=chans, simulated=None, segmentation=inv.segmentation,
+                           seg_signal=chans["susp_disp_3L"], title=f"({drive.name})", which="6")
+            fig6 = pool.submit(write_figures, tmp / "figures", **fig6_kw) if pool is not None else None
+            if fig6 is None:
+                write_figures(tmp / "figures", **fig6_kw)
             if pool is not None:
                 from concurrent.futures import ThreadPoolExecutor
                 sel_thread = ThreadPoolExecutor(1)
@@ -385,9 +394,10 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                    "bounds": {k: list(getattr(bounds, k)) for k in ("Gq_n0", "w", "nmin", "nmax")}}
             (tmp / "config.toml").write_text(tomli_w.dumps(cfg))
             if figures is None:
-                write_figures(tmp / "figures", **fig_kw)
+                write_figures(tmp / "figures", which="89", **fig_kw)
             else:
-                figures.result()
+                for f in [fig6, *figures]:
+                    f.result()
             timing["total_s"] = _time.perf_counter() - t0
             # the wall the report adds after the selection (the road model and the lateral
             # summary ran during the selection when there was a pool)

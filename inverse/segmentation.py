@@ -436,8 +436,9 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
         [s].
     signal : (N,) array
         Suspension displacement to show [m] (e.g. axle 3 left).
-    path : str or Path
-        Output file (.png or .pdf).
+    path : str or Path, or a list of them
+        Output file(s) (.png or .pdf); the figure is drawn once and saved to each.
+        Returns the first.
     title : str
     truth_bounds : array, optional
         Known boundaries [s] (synthetic data) drawn dashed.
@@ -478,7 +479,8 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
              "'segment' column), where each segment's fitted class and parameters are.",
              fontsize=7, color="0.3")
     fig.tight_layout(rect=(0, 0.02, 1, 1))
-    path = Path(path)
-    fig.savefig(path, dpi=150)
+    paths = [Path(p) for p in path] if isinstance(path, (list, tuple)) else [Path(path)]
+    for p in paths:       # one drawing, every format asked for
+        fig.savefig(p, dpi=150)
     plt.close(fig)
-    return path
+    return paths[0]

@@ -166,10 +166,11 @@ def plot_time_compare(time, measured: dict, simulated: dict, channels, path, win
              "character, not the waveform (two unrelated signals give eq 6 RMSE about 1.4).",
              fontsize=7, color="0.3")
     fig.tight_layout(rect=(0, 0.03, 1, 1))
-    path = Path(path)
-    fig.savefig(path, dpi=150)
+    paths = [Path(p) for p in path] if isinstance(path, (list, tuple)) else [Path(path)]
+    for p in paths:       # one drawing, every format asked for
+        fig.savefig(p, dpi=150)
     plt.close(fig)
-    return path
+    return paths[0]
 
 
 def plot_amplitude_distributions(measured: dict, simulated: dict, channels, path, bins: int = 60,
@@ -214,7 +215,8 @@ def plot_amplitude_distributions(measured: dict, simulated: dict, channels, path
              "simulated amplitude\ndistributions over the measured standard deviation (0: identical). "
              "Simulated: one random-phase road of the fitted spectra.", fontsize=7, color="0.3")
     fig.tight_layout(rect=(0, 0.07, 1, 1))
-    path = Path(path)
-    fig.savefig(path, dpi=150)
+    paths = [Path(p) for p in path] if isinstance(path, (list, tuple)) else [Path(path)]
+    for p in paths:       # one drawing, every format asked for
+        fig.savefig(p, dpi=150)
     plt.close(fig)
-    return path
+    return paths[0]
