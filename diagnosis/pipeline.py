@@ -319,12 +319,10 @@ class TruckModel:
     #: (``vehicles.simulate(lift_off_expected=True)``, same physics, less time).  Fixed before
     #: the model is sent to the workers, so which path a run takes does not depend on them.
     lift_times: np.ndarray | None = None
-    _last_lift_times: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def __getstate__(self):
         d = dict(self.__dict__)
         d["_roads"] = {}
-        d["_last_lift_times"] = None
         return d
 
     @property
@@ -400,8 +398,9 @@ class TruckModel:
         self._roads[key] = road
         return road
 
-    def run(self, effects, t0: float, t1: float, seed: int, gq=None) -> dict:
-        """Noise-free channels over record window [t0, t1) s (run-in discarded)."""
+    def run(self, effects, t0: float, t1: float, seed: int, gq=None, with_lift_times: bool = False):
+        """Noise-free channels over record window [t0, t1) s (run-in discarded); with
+        ``with_lift_times`` also the record times [s] at which a tyre was off the road."""
         from vehicles.simulate import SpeedProfile, simulate
 
         gq = self.gq if gq is None else np.asarray(gq, float)
@@ -421,14 +420,15 @@ class TruckModel:
         expected = lt is not None and bool(np.any((lt >= t0 - LIFT_HINT_MARGIN_S) & (lt < t1)))
         res = simulate(self._vp(), road, prof, dur, effects=effects or None, x_start=x_start,
                        fs_out=self.fs, seed=int(seed), lift_off_expected=expected)
-        off = np.asarray(res.extra.get("tyre_off", np.zeros(0, bool)))[n_run:n_run + n]
-        self._last_lift_times = float(t0) + np.nonzero(off)[0] / self.fs
         out = {}
         for c in self.channels:
             x = np.asarray(res.channels[c], float)[n_run:n_run + n]
             if x.size < n:
                 x = np.concatenate([x, np.full(n - x.size, x[-1])])
             out[c] = x
+        if with_lift_times:
+            off = np.asarray(res.extra["tyre_off"])[n_run:n_run + n]
+            return out, float(t0) + np.nonzero(off)[0] / self.fs
         return out
 
     def add_noise(self, chans: dict, seed: int, noise: dict | None = None) -> dict:
@@ -1105,8 +1105,7 @@ def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fi
     else:
         raise EroadInputError(f"road_fit must be 'levels' or 'inverse', got {road_fit!r}")
     T = sig.time.size / sig.fs
-    simc = model.run({}, 0.0, T, seed + 1)
-    model.lift_times = model._last_lift_times
+    simc, model.lift_times = model.run({}, 0.0, T, seed + 1, with_lift_times=True)
     model.noise = noise_from_residual(sig, simc)
     segs = [(f"S{k + 1}", float(bounds[k]), float(bounds[k + 1])) for k in range(len(bounds) - 1)]
     return Context(model, calib, held, edges, bounds, cal_edges, simc, segs,

@@ -308,16 +308,18 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         timing["road_model_s"] = _time.perf_counter() - t
         sel_thread = None
         try:
-            # With a pool, the selection (and then the figures) run from a thread of this process
-            # on the pool's workers, while this process computes what needs the fit only: the
-            # lateral-structure sensitivity.
             # Figure 6 needs the fit only: drawn now (in a pool worker: the selection leaves the
             # workers mostly idle, its 3 simulations aside)
             fig6_kw = dict(time=time, measured=chans, simulated=None, segmentation=inv.segmentation,
                            seg_signal=chans["susp_disp_3L"], title=f"({drive.name})", which="6")
-            fig6 = pool.submit(write_figures, tmp / "figures", **fig6_kw) if pool is not None else None
-            if fig6 is None:
+            fig6 = None
+            if pool is None:
                 write_figures(tmp / "figures", **fig6_kw)
+            else:
+                fig6 = pool.submit(write_figures, tmp / "figures", **fig6_kw)
+            # With a pool, the selection (and then the figures) run from a thread of this process
+            # on the pool's workers, while this process computes what needs the fit only: the
+            # lateral-structure sensitivity.
             if pool is not None:
                 from concurrent.futures import ThreadPoolExecutor
                 sel_thread = ThreadPoolExecutor(1)

@@ -534,6 +534,7 @@ def _summary(table, cases, sweep, road_label: str) -> dict:
 
     lift_max = float(np.nanmax(drive["tyre_lift_off_percent"].to_numpy(float))) \
         if drive["tyre_lift_off_percent"].notna().any() else float("nan")
+    tractor = tractor_range(lift_max, _grid_tyres(drive))
     bl = [_band_label(b) for b in FORCE_BANDS]
     band_ms = {b: float(np.mean(drive[f"dF_rms_{b}Hz_N"] ** 2)) for b in bl}
     tot = sum(band_ms.values())
@@ -549,9 +550,9 @@ def _summary(table, cases, sweep, road_label: str) -> dict:
         "lowest_sd": pick(drive["sd_N"].idxmin()), "highest_sd": pick(drive["sd_N"].idxmax()),
         "max_loss_percent": float(drive["loss_percent"].max()),
         "max_tyre_lift_off_percent": lift_max,
-        "tractor_tyres": _grid_tyres(drive),
-        "tractor_within_model_range": tractor_range(lift_max, _grid_tyres(drive))["within_model_range"],
-        "tractor_note": tractor_range(lift_max, _grid_tyres(drive))["note"],
+        "tractor_tyres": tractor["tyres"],
+        "tractor_within_model_range": tractor["within_model_range"],
+        "tractor_note": tractor["note"],
         "lowest_unfiltered_force_N": float(drive["unfiltered_min_N"].min()),
         "max_lateral_offset_mm": float(drive["lateral_max_mm"].max()),
         "head_half_width_mm": float(drive["head_half_width_mm"].iloc[0]),

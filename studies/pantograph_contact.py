@@ -155,9 +155,9 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
     dict
         ``result`` (:class:`ContactResult`), ``static`` (or None), ``stats`` and
         ``stats_static`` (dicts), ``lateral`` (dict), ``lateral_series`` (time, offset),
-        ``wall`` timings [s], ``config``, ``tractor`` (tyre lift-off share of the drive
-        [%], whether it is below :data:`LIFT_OFF_LIMIT_PERCENT`, the sentence of
-        :func:`tractor_range`).
+        ``wall`` timings [s], ``config``, ``tractor`` (:func:`tractor_range` of the drive:
+        its tyre lift-off share [%], its tyre model, whether it is within the model's range,
+        a sentence).
     """
     from studies.figure11 import (DEFAULT_VEHICLE, drive_base_motion, max_duration,
                                   tractor_variant)

@@ -49,7 +49,10 @@ class SimResult:
         ``fs_out`` [Hz], ``duration`` [s], ``steps``, ``wall_s`` [s], ``realtime_factor``
         (simulated seconds per wall-clock second), ``n_dof``, ``speed_mean`` [m/s],
         ``x_start`` [m], ``y_offset`` [m], ``tyre_lift_off_fraction`` (share of samples
-        in which some tyre force would be tensile), ``seed``, versions.
+        in which some tyre carries no force), ``tyre_pull_fraction`` (share in which a
+        linear tyre would pull), ``tyres`` (``"unilateral"`` or ``"bilateral"``),
+        ``tyre_contact_run`` (``"linear"`` or ``"unilateral"``: the run kept),
+        ``tyre_off_steps``, ``seed``, versions.
     extra : dict of str -> ndarray
         Not dataset channels: ``dcdc_ref`` (N, 6) rigid-body motion of the DCDC block's
         top-face centre from static, columns ``Tx, Ty, Tz`` [m], ``Rx, Ry, Rz`` [rad]
@@ -59,7 +62,8 @@ class SimResult:
         ``dcdc_ref_vel`` (N, 3) angular velocity [rad/s];
         ``road_z`` (N, n_contacts) road height under each tyre [m] (as seen by the
         model, after the footprint filter); ``tyre_force`` (N, n_contacts) dynamic
-        tyre force change [N].
+        tyre force change [N] (of the one-sided tyre when the corrected run was kept);
+        ``tyre_off`` (N,) bool: some tyre carries no force.
     vehicle : VehicleParams or None
         The (effect-modified) vehicle that was simulated.
     nominal_vehicle : VehicleParams or None

@@ -384,10 +384,7 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     res = _simulate_retrying(vehicle, road, speed, duration, dt, newton, direct, kw)
     if tyres == "unilateral" and not direct and res.meta["tyre_pull_fraction"] > 0:
         res = _simulate_retrying(vehicle, road, speed, duration, dt, newton, True, kw)
-        res.meta["wall_s"] = _time.perf_counter() - wall0
-        res.meta["cpu_s"] = _time.process_time() - cpu0
-        res.meta["realtime_factor"] = res.meta["duration"] / res.meta["wall_s"]
-        res.meta["cpu_realtime_factor"] = res.meta["duration"] / res.meta["cpu_s"]
+        _stamp_times(res, wall0, cpu0)
     res.meta["tyres"] = tyres
     return res
 
@@ -417,11 +414,17 @@ def _simulate_retrying(vehicle, road, speed, duration, dt, newton, unilateral, k
         return res
     res.meta["newton_fallback"] = fallback
     res.meta["dt_halvings"] = halvings
+    _stamp_times(res, wall0, cpu0)
+    return res
+
+
+def _stamp_times(res: SimResult, wall0: float, cpu0: float) -> None:
+    """Wall and CPU time since ``wall0``/``cpu0`` and the real-time factors, into ``res.meta``
+    (when a drive took more than one run)."""
     res.meta["wall_s"] = _time.perf_counter() - wall0
     res.meta["cpu_s"] = _time.process_time() - cpu0
     res.meta["realtime_factor"] = res.meta["duration"] / res.meta["wall_s"]
     res.meta["cpu_realtime_factor"] = res.meta["duration"] / res.meta["cpu_s"]
-    return res
 
 
 def _simulate(*args, **kw) -> SimResult:
