@@ -1422,6 +1422,9 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     meta = {
         "dataset": os.path.relpath(Path(dataset).resolve(), out.resolve()),
         "dataset_name": drive.name, "vehicle": str(vp.id),
+        # record time of the first sample: every *_s window and segment time in this summary
+        # counts from that sample; the report adds this to show record times (as Table 1)
+        "record_t0_s": float(np.asarray(drive.time, float)[0]),
         "duration_s": float(T), "channels": list(sig.channels),
         "road_segments": [{"segment": s[0], "t_start_s": s[1], "t_end_s": s[2],
                            "Gq_n0_m3": float(model.gq[k]), "w": float(model.w[k]),

@@ -223,11 +223,31 @@ def plot_heatmap(summary: Mapping, path: str | os.PathLike, segment: str = "all"
     return Path(path)
 
 
+def segment_times(summary: Mapping) -> dict:
+    """Segment label -> (t_start, t_end) in record time [s], as Table 1 of the inversion.
+
+    The diagnosis works in time from the dataset's first sample (``windows_s``); the record
+    time of that sample is ``meta.record_t0_s`` (0 for summaries written before it existed).
+    """
+    st = summary.get("localization_settings") or {}
+    t0 = float((summary.get("meta") or {}).get("record_t0_s") or 0.0)
+    return {seg: (t0 + float(w[0]), t0 + float(w[1]))
+            for seg, w in zip(st.get("segments", []), st.get("windows_s", []))}
+
+
+def segment_label(summary: Mapping, seg: str) -> str:
+    """``S1 (460.0-472.6 s)``: a segment with its record times; ``all`` stays ``all``."""
+    times = segment_times(summary)
+    if seg == "all" or seg not in times:
+        return seg
+    a, b = times[seg]
+    return f"{seg} ({a:.1f}-{b:.1f} s)"
+
+
 def plot_segments(summary: Mapping, path: str | os.PathLike) -> Path:
-    """Per-segment view: one channel x band heat map per road segment (PNG)."""
+    """Per-segment view: one channel x band heat map per road segment (PNG); titles in
+    record time."""
     segs = [s for s in summary["localization_settings"]["segments"] if s != "all"] or ["all"]
-    wins = dict(zip(summary["localization_settings"]["segments"],
-                    summary["localization_settings"]["windows_s"]))
     nch = len(summary["localization_settings"]["channels"])
     # a grid, two segments a row (one long strip per segment made a 1:4 image)
     ncol = 1 if len(segs) == 1 else 2
@@ -242,8 +262,8 @@ def plot_segments(summary: Mapping, path: str | os.PathLike) -> Path:
         im = _heat(ax, chans, fc, val, sig, est, vlim)
         if k % ncol:
             ax.set_yticklabels([])
-        t0, t1 = wins[seg]
-        ax.set_title(f"segment {seg} ({t0:.1f}-{t1:.1f} s): {int(sig.sum())} flagged", fontsize=8)
+        ax.set_title(f"segment {segment_label(summary, seg)}: {int(sig.sum())} flagged",
+                     fontsize=8)
         if k >= len(segs) - ncol:
             ax.set_xlabel("third-octave band centre [Hz]", fontsize=8)
     for ax in axes[len(segs):]:
@@ -442,7 +462,7 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
             L.append("| segment | channel | band [Hz] | ln ratio | interval | P_sim/P_meas |")
             L.append("|---|---|---|---|---|---|")
             for r in top:
-                L.append(f"| {r['segment']} | {r['channel']} | {r['band_hz'][0]:.3g}-{r['band_hz'][1]:.3g} "
+                L.append(f"| {segment_label(summary, r['segment'])} | {r['channel']} | {r['band_hz'][0]:.3g}-{r['band_hz'][1]:.3g} "
                          f"| {r['log_psd_ratio']:+.2f} | [{r['ci_lo']:+.2f}, {r['ci_hi']:+.2f}] "
                          f"| {math.exp(r['log_psd_ratio']):.2f} |")
             L.append("")
@@ -450,7 +470,10 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
             L.append("No cell is flagged: the simulation agrees with the measurement within "
                      "statistical noise.\n")
         if "segments" in figures:
-            L.append(f"Per segment:\n\n![per segment]({figures['segments']})\n")
+            L.append("Per segment (record time, as Table 1 of the inversion): "
+                     + ", ".join(segment_label(summary, g) for g in segment_times(summary)
+                                 if g != "all")
+                     + f".\n\n![per segment]({figures['segments']})\n")
     if summary.get("transmissibility") or summary.get("front_rear") or summary.get("distribution"):
         L.append("## Comparisons the road mostly cancels\n")
         L.append("Ratios of channels of one record: most of the unknown road cancels. Not all of "

@@ -133,3 +133,29 @@ def test_report_figures_read_right(tmp_path, results, monkeypatch):
         x = np.asarray(line.get_xdata(), float)
         assert fc0 not in x and np.isfinite(np.asarray(line.get_ydata(), float)).all()
     assert "no estimate at" in ax.get_title()
+
+
+def test_segments_in_record_time(tmp_path, results, monkeypatch):
+    """Issue 15 item 5: a dataset that is a window of a longer drive (first sample at 460 s)
+    shows its segments in record time, as Table 1 of the inversion does, in the report's
+    table, its segment list and the segments figure's titles; summary.json keeps the windows
+    from the first sample (scripts read them) and says where that sample sits."""
+    from diagnosis.report import plot_segments, segment_label
+
+    out = write_report(tmp_path / "run", meta={"dataset": "toy", "record_t0_s": 460.0},
+                       **results)
+    s = json.loads((out / "summary.json").read_text())
+    assert s["localization_settings"]["windows_s"] == [[0.0, 60.0], [0.0, 30.0], [30.0, 60.0]]
+    assert segment_label(s, "S2") == "S2 (490.0-520.0 s)"
+    assert segment_label(s, "all") == "all"
+    md = (out / "report.md").read_text()
+    assert "S1 (460.0-490.0 s), S2 (490.0-520.0 s)" in md
+    flagged = [ln for ln in md.splitlines() if ln.startswith("| S")]
+    assert flagged and all(" s) |" in ln for ln in flagged), flagged[:3]
+    saved = _captured_figures(monkeypatch)
+    plot_segments(s, tmp_path / "seg.png")
+    titles = [ax.get_title() for ax in saved[-1].axes if ax.get_visible() and ax.get_title()]
+    assert any(t.startswith("segment S1 (460.0-490.0 s)") for t in titles), titles
+    # a summary written before the field existed reads from 0
+    del s["meta"]["record_t0_s"]
+    assert segment_label(s, "S1") == "S1 (0.0-30.0 s)"
