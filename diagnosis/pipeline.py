@@ -1404,7 +1404,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                                  shape=shape_term(model), extra_terms=[transmissibility_term(model)],
                                  **kw)
                     for c, h, sd in splits]
-        ranking = rankings[0] if folds == 1 else combine_folds(rankings)
+        ranking = rankings[0] if folds == 1 else combine_folds(rankings, candidates=cands)
         timing["ranking_s"] = _time.perf_counter() - t
         # the winner's signature: its axle-to-body transmissibility on the
         # nominal model's road and seed, against the measurement (diagnosis.verdict); both the

@@ -178,6 +178,20 @@ def test_two_folds_combine_the_held_out_evidence():
         if want != "none":
             w = r.winner
             assert w.null_sd < max(f.null_sd for x in rs for f in x.entries if f.effect == want)
+        # given the candidates, the reported calibration is the folds' mean in the search's
+        # unit coordinates: the geometric mean for a log-searched parameter, the arithmetic
+        # mean for a linear one; without them, the first fold's (as before)
+        rc = combine_folds(rs, candidates=toy.TOY_CANDIDATES)
+        assert any(len({str(fe) for fe in e.fold_effects}) > 1 for e in rc.entries)
+        assert [e.effect for e in rc.entries] == [e.effect for e in r.entries]
+        for e, e0 in zip(rc.entries, r.entries):
+            (pname, val), = e.effects[e.effect].items()
+            vals = [fe[e.effect][pname] for fe in e.fold_effects]
+            mean = (float(np.mean(vals)) if e.effect == "payload"
+                    else float(np.exp(np.mean(np.log(vals)))))
+            assert val == pytest.approx(mean, rel=1e-12)
+            assert e0.effects == e.fold_effects[0]
+            assert e.improvement == e0.improvement   # the held-out evidence is the folds'
 
 
 def test_shape_term_skewness_and_its_noise():
