@@ -13,7 +13,8 @@ adds (or, without ``--road``, runs only) the railway reference case at 250 and 3
 contact-force terms instead: one drive per frame x DCDC-mount stiffness configuration
 and one with the base still, in worker processes, into
 ``DIR/pantograph_chassis/<run-id>/`` (or the named ``--run-dir``) with ``data/table.csv``,
-``data/table.md`` and ``figures/contact_vs_stiffness.png``
+``data/table.md`` and ``figures/contact_vs_stiffness.png``; ``--seeds N`` drives the grid
+on N statistically equivalent road realisations too (``figures/realisations.png``)
 (:func:`studies.pantograph_chassis.run_pantograph_chassis`).
 See ``docs/pantograph_contact.md``.
 """
@@ -22,12 +23,13 @@ from __future__ import annotations
 import argparse
 import json
 
-from eroad.argtypes import positive_float
+from eroad.argtypes import nonnegative_int, positive_float
 
 __all__ = ["register"]
 
 
 _positive = positive_float
+_nonnegative_int = nonnegative_int
 
 
 def _factor_list(text: str, allow_rigid: bool) -> tuple:
@@ -95,6 +97,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "(default 0.25,0.5,1,2,4,16,rigid)")
     g.add_argument("--mounts", type=_mounts, default=None, metavar="LIST",
                    help="DCDC mount stiffness factors, comma-separated (default 0.5,1,2)")
+    g.add_argument("--seeds", type=_nonnegative_int, default=0, metavar="N",
+                   help="also drive the grid on N statistically equivalent road realisations "
+                   "(as the chassis study: the file's generator segments or its ISO 8608 "
+                   "fit, new phases; default 0)")
+    g.add_argument("--seed", type=int, default=2026,
+                   help="root seed of the road realisations (default 2026)")
     g.add_argument("--run-dir", default=None, metavar="DIR",
                    help="write the grid run into this named folder (must not exist or be "
                    "empty) instead of DIR/pantograph_chassis/<run-id>/")
@@ -161,7 +169,8 @@ def _run_grid(args: argparse.Namespace) -> int:
         args.road, args.out, run_dir=args.run_dir,
         frames=args.frames or FRAME_FACTORS, mounts=args.mounts or MOUNT_FACTORS,
         speed_kmh=args.speed_kmh, duration=args.duration, line=args.line,
-        pantograph=args.pantograph, dt=args.dt, command=sys.argv, **sweep_kwargs(args))
+        pantograph=args.pantograph, dt=args.dt, seeds=args.seeds, seed=args.seed,
+        command=sys.argv, **sweep_kwargs(args))
     if args.json:
         print(json.dumps(s, indent=2, default=str))
         return 0
@@ -177,5 +186,11 @@ def _run_grid(args: argparse.Namespace) -> int:
           f"{s['head_half_width_mm']:.0f} mm")
     if s.get("tractor_note"):
         print(f"tractor (worst configuration): {s['tractor_note']}")
+    R = s.get("realisations")
+    if R:
+        print(f"over {R['n_roads']} equivalent roads: the chassis grid spans "
+              f"{R['chassis_span_N'][0]:.2f}-{R['chassis_span_N'][1]:.2f} N of sd per road, one "
+              f"configuration spans {R['road_span_N'][0]:.2f}-{R['road_span_N'][1]:.2f} N over "
+              f"the roads; contact loss at most {R['max_loss_percent_any_road']:.2f} %")
     print(s["path"])
     return 0

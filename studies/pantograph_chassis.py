@@ -29,8 +29,16 @@ seconds, see :func:`studies.pantograph_contact.contact_drive`); statistics over 
 contact run after its first second, 20 Hz low-pass (EN 50318); contact loss from the
 unfiltered force.  The frame factors and mount factors default to the chassis study's.
 
-What it is not: a new tractor, pantograph or line model, or a road-realisation sweep (the
-chassis study's equivalent roads are not driven here; one road, one speed per run).
+Road realisations (``seeds``, since 2026-11-25): the grid can also be driven over
+statistically equivalent roads (:func:`studies.chassis_study.road_specs`: the road file's
+own generator segments, or an ISO 8608 fit of a measured or identified road, new phases).
+One road is one draw: a chassis difference smaller than the spread of one configuration
+over equivalent roads is not a property of the chassis. The figure, ``table.md``'s first
+table and the summary's top-level numbers stay the road file's; :func:`realisation_summary`
+and ``figures/realisations.png`` put every road side by side, with each configuration's sd
+paired against the nominal configuration on the same road (the road's part cancels).
+
+What it is not: a new tractor, pantograph or line model; one speed per run.
 """
 from __future__ import annotations
 
@@ -47,7 +55,8 @@ from eroad.errors import EroadInputError
 
 __all__ = ["STUDY", "FRAME_FACTORS", "MOUNT_FACTORS", "FORCE_BANDS", "TABLE_COLUMNS",
            "code_version", "study_cases", "contact_case", "band_rms", "collect",
-           "table_markdown", "plot_pantograph_chassis", "run_pantograph_chassis"]
+           "table_markdown", "plot_pantograph_chassis", "run_pantograph_chassis",
+           "realisation_summary", "plot_realisations", "FILE_ROAD"]
 
 #: study name (folder under the results root)
 STUDY = "pantograph_chassis"
@@ -62,6 +71,8 @@ MOUNT_FACTORS: tuple = (0.5, 1.0, 2.0)
 FORCE_BANDS: tuple = ((0.0, 0.5), (0.5, 5.0), (5.0, 15.0), (15.0, 20.0), (20.0, None))
 #: statistics start this long after the start of the contact run [s]
 T_START = 1.0
+#: ``road`` of the road file's rows (equivalent realisations: ``realisation 1``, ...)
+FILE_ROAD = "road file"
 #: sources whose content is part of the cache's code version
 _CODE_FILES = ("studies/pantograph_chassis.py", "studies/pantograph_contact.py",
                "studies/figure11.py", "studies/pantograph.py", "studies/chassis_study.py",
@@ -81,7 +92,7 @@ def _band_label(band) -> str:
 
 #: the table's columns, in order (units in the names; ``frame`` "-" on the still row)
 TABLE_COLUMNS: tuple = (
-    "base", "frame", "mount", "frame_torsion_hz", "frame_bending_hz", "dcdc_bounce_hz",
+    "base", "road", "frame", "mount", "frame_torsion_hz", "frame_bending_hz", "dcdc_bounce_hz",
     "base_z_rms_mm", "base_vz_rms_mm_s",
     "mean_N", "sd_N", "fm_minus_3sd_N", "fm_plus_3sd_N", "min_N", "max_N",
     "unfiltered_min_N", "loss_percent",
@@ -309,6 +320,7 @@ def collect(cases: list[dict], results: list[dict], lowpass_hz: float = 20.0):
         d_band = band_rms(dF[sel], fs)
         v_band = band_rms(vz[sel], fs)
         row = {"base": "still" if is_still else "drive",
+               "road": str(c.get("road_label", FILE_ROAD)),
                "frame": "-" if is_still else str(c["frame"]),
                "mount": float("nan") if is_still else float(c["mount"]),
                "frame_torsion_hz": float("nan") if is_still else r["frame_torsion_hz"],
@@ -341,13 +353,23 @@ def collect(cases: list[dict], results: list[dict], lowpass_hz: float = 20.0):
     return table, {"time": t, "force": np.array(forces), "base_z": np.array(bases)}
 
 
+def file_rows(table):
+    """The road file's rows (every row of a table written before the ``road`` column)."""
+    if "road" not in table:
+        return table
+    return table[table["road"].astype(str) == FILE_ROAD]
+
+
 def _f(v, fmt="{:.1f}") -> str:
     return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else fmt.format(v)
 
 
 def table_markdown(table) -> str:
-    """Two markdown tables: the contact-force quality per configuration and the
-    base-induced force per band with the base velocity per band."""
+    """Two markdown tables of the road file's rows: the contact-force quality per
+    configuration and the base-induced force per band with the base velocity per band;
+    with equivalent road realisations a third: sd and loss per configuration and road."""
+    full = table
+    table = file_rows(table)
     bl = [_band_label(b) for b in FORCE_BANDS]
     lines = ["| frame | mount | Fm [N] | sd [N] | Fm-3sd [N] | min [N] | max [N] | "
              "loss [%] | base-induced sd [N] | lateral max / half-width [mm] | "
@@ -371,7 +393,118 @@ def table_markdown(table) -> str:
         lines.append(f"| {r['frame']} | {r['mount']:g} | "
                      + " | ".join(_f(r[f"dF_rms_{b}Hz_N"], "{:.2f}") for b in bl) + " | "
                      + " | ".join(_f(r[f"vz_rms_{b}Hz_mm_s"], "{:.1f}") for b in bl) + " |")
+    roads = _roads(full)
+    if len(roads) > 1:
+        drive = full[full["base"] == "drive"]
+        lines += ["", "Every road (the file and its statistically equivalent realisations): "
+                  "contact-force sd [N] / contact loss [%] / tyre lift-off [% of samples]; "
+                  "paired: sd minus the nominal configuration's (frame 1, mount 1) on the "
+                  "same road [N]:", "",
+                  "| frame | mount | " + " | ".join(roads) + " | paired, per road |",
+                  "|---|---|" + "---|" * (len(roads) + 1)]
+        paired = _paired_sd(drive, roads)
+        for (fr, mo), g in drive.groupby(["frame", "mount"], sort=False):
+            cells = []
+            for rd in roads:
+                r = g[g["road"] == rd]
+                cells.append("-" if r.empty else
+                             f"{_f(r['sd_N'].iloc[0], '{:.2f}')} / "
+                             f"{_f(r['loss_percent'].iloc[0], '{:.2f}')} / "
+                             f"{_f(r['tyre_lift_off_percent'].iloc[0], '{:.1f}')}")
+            pd_ = paired.get((str(fr), float(mo)))
+            lines.append(f"| {fr} | {mo:g} | " + " | ".join(cells) + " | "
+                         + ("-" if pd_ is None else
+                            ", ".join(_f(v, "{:+.2f}") for v in pd_)) + " |")
     return "\n".join(lines) + "\n"
+
+
+def _roads(table) -> list[str]:
+    """Road labels of a table, the file first."""
+    if "road" not in table:
+        return [FILE_ROAD]
+    labs = list(dict.fromkeys(table["road"].astype(str)))
+    return sorted(labs, key=lambda r: (r != FILE_ROAD, r))
+
+
+def _nominal_key(drive):
+    """(frame, mount) of the nominal configuration: frame 1 and mount 1 where in the grid,
+    else the configuration closest to them."""
+    keys = [(str(f), float(m)) for f, m in zip(drive["frame"], drive["mount"])]
+
+    def dist(k):
+        f = 1e3 if k[0] == "rigid" else float(k[0])
+        return abs(math.log(f)) + abs(math.log(k[1]))
+    return min(dict.fromkeys(keys), key=dist)
+
+
+def _paired_sd(drive, roads) -> dict:
+    """(frame, mount) -> per road, sd minus the nominal configuration's sd on that road [N]."""
+    nom = _nominal_key(drive)
+    ref = {}
+    for rd in roads:
+        r = drive[(drive["road"] == rd) & (drive["frame"].astype(str) == nom[0])
+                  & (drive["mount"] == nom[1])]
+        if not r.empty:
+            ref[rd] = float(r["sd_N"].iloc[0])
+    out = {}
+    for (fr, mo), g in drive.groupby(["frame", "mount"], sort=False):
+        vals = []
+        for rd in roads:
+            r = g[g["road"] == rd]
+            if not r.empty and rd in ref:
+                vals.append(float(r["sd_N"].iloc[0]) - ref[rd])
+        out[(str(fr), float(mo))] = vals
+    return out
+
+
+def realisation_summary(table) -> dict | None:
+    """How the contact statistics move over equivalent roads against over the chassis grid.
+
+    Per road: the sd range over the configurations, the largest contact loss and tyre
+    lift-off. Per configuration: the sd's median and range over the roads. Paired: each
+    configuration's sd minus the nominal configuration's on the same road, its range over
+    the roads, and on how many roads its sign is that of the road file's. The two
+    spreads the engineer weighs: ``chassis_span_N`` (largest sd minus smallest over the
+    configurations, per road) against ``road_span_N`` (largest minus smallest over the
+    roads, per configuration). None with a single road.
+    """
+    roads = _roads(table)
+    if len(roads) < 2:
+        return None
+    drive = table[table["base"] == "drive"]
+    per_road = {}
+    for rd in roads:
+        g = drive[drive["road"] == rd]
+        lift = g["tyre_lift_off_percent"].to_numpy(float)
+        per_road[rd] = {"sd_N_range": [float(g["sd_N"].min()), float(g["sd_N"].max())],
+                        "max_loss_percent": float(g["loss_percent"].max()),
+                        "lowest_unfiltered_force_N": float(g["unfiltered_min_N"].min()),
+                        "max_tyre_lift_off_percent": (float(np.nanmax(lift))
+                                                      if np.isfinite(lift).any() else None)}
+    paired = _paired_sd(drive, roads)
+    per_config = []
+    for (fr, mo), g in drive.groupby(["frame", "mount"], sort=False):
+        sd = g["sd_N"].to_numpy(float)
+        pv = np.asarray(paired[(str(fr), float(mo))], float)
+        sign0 = np.sign(pv[0]) if pv.size else 0.0
+        per_config.append({
+            "frame": str(fr), "mount": float(mo), "sd_N_median": float(np.median(sd)),
+            "sd_N_range": [float(sd.min()), float(sd.max())],
+            "loss_percent_range": [float(g["loss_percent"].min()),
+                                   float(g["loss_percent"].max())],
+            "paired_sd_N": [float(v) for v in pv],
+            "paired_sd_N_range": [float(pv.min()), float(pv.max())] if pv.size else None,
+            "paired_same_sign_roads": (int(np.sum(np.sign(pv) == sign0)) if sign0 != 0
+                                       else None)})
+    chassis = [v["sd_N_range"][1] - v["sd_N_range"][0] for v in per_road.values()]
+    road = [c["sd_N_range"][1] - c["sd_N_range"][0] for c in per_config]
+    nom = _nominal_key(drive)
+    return {"roads": roads, "n_roads": len(roads),
+            "nominal_configuration": {"frame": nom[0], "mount": nom[1]},
+            "per_road": per_road, "per_configuration": per_config,
+            "chassis_span_N": [float(min(chassis)), float(max(chassis))],
+            "road_span_N": [float(min(road)), float(max(road))],
+            "max_loss_percent_any_road": float(drive["loss_percent"].max())}
 
 
 def _frame_x(frames: list[str]) -> tuple[dict, list[float], list[str]]:
@@ -400,7 +533,7 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
     import matplotlib.pyplot as plt
     import pandas as pd
 
-    df = pd.read_csv(table_csv, dtype={"frame": str})
+    df = file_rows(pd.read_csv(table_csv, dtype={"frame": str, "road": str}))
     drive = df[df["base"] == "drive"].copy()
     still = df[df["base"] == "still"]
     frames = list(dict.fromkeys(drive["frame"]))
@@ -512,6 +645,72 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
     return save_png_pdf(fig, path, dpi=110)
 
 
+def plot_realisations(table_csv: str | Path, path: str | Path, *, title: str = ""
+                      ) -> list[Path]:
+    """Every road side by side (from the saved table): (a) contact-force sd against the
+    frame factor at the nominal mounts, one line per road; (b) the same paired against the
+    nominal configuration on its own road; (c) contact loss. Writes PNG and PDF."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    df = pd.read_csv(table_csv, dtype={"frame": str, "road": str})
+    drive = df[df["base"] == "drive"].copy()
+    roads = _roads(drive)
+    frames = list(dict.fromkeys(drive["frame"]))
+    pos, ticks, tlabels = _frame_x(frames)
+    drive["x"] = [pos[f] for f in drive["frame"]]
+    nom = _nominal_key(drive)
+    paired = _paired_sd(drive, roads)
+    drive["paired"] = [paired[(str(f), float(m))][roads.index(r)]
+                       if len(paired[(str(f), float(m))]) == len(roads) else np.nan
+                       for f, m, r in zip(drive["frame"], drive["mount"], drive["road"])]
+    g_nom = drive[drive["mount"] == nom[1]]
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.8))
+    for k, rd in enumerate(roads):
+        g = g_nom[g_nom["road"] == rd].sort_values("x")
+        kw = dict(color="k" if rd == FILE_ROAD else plt.get_cmap("tab10")(k % 10),
+                  lw=1.8 if rd == FILE_ROAD else 1.1, ms=5)
+        for a, col in zip(ax, ("sd_N", "paired", "loss_percent")):
+            a.plot(g["x"], g[col], "o-", label=rd, **kw)
+    still = df[df["base"] == "still"]
+    if len(still):
+        ax[0].axhline(float(still["sd_N"].iloc[0]), color="0.5", ls="--", lw=1.0,
+                      label=f"base still: {float(still['sd_N'].iloc[0]):.2f} N")
+    chassis = max(float(g["sd_N"].max() - g["sd_N"].min()) for _, g in drive.groupby("road"))
+    road = max(float(g["sd_N"].max() - g["sd_N"].min())
+               for _, g in drive.groupby(["frame", "mount"]))
+    ax[0].set_ylabel("contact-force sd [N] (20 Hz low-pass)")
+    ax[0].set_title(f"(a) sd per road (DCDC mounts x{nom[1]:g}): chassis grid spans <= "
+                    f"{chassis:.2f} N,\none configuration over the roads <= {road:.2f} N",
+                    fontsize=9.5)
+    ax[1].axhline(0.0, color="0.5", lw=0.8)
+    ax[1].set_ylabel(f"sd minus sd(frame {nom[0]}, mounts x{nom[1]:g}) on the same road [N]")
+    ax[1].set_title("(b) paired on the road: what the chassis changes", fontsize=9.5)
+    ax[2].set_ylabel("contact loss [% of time]")
+    lmax = float(drive["loss_percent"].max())
+    ax[2].set_title(f"(c) contact loss (largest {lmax:.2f} %)", fontsize=9.5)
+    if lmax == 0.0:
+        ax[2].set_ylim(-0.5, 5.0)
+        ax[2].text(0.5, 0.2, "no contact loss on any road", ha="center",
+                   transform=ax[2].transAxes, fontsize=10)
+    for a in ax:
+        a.set_xscale("log")
+        a.set_xticks(ticks)
+        a.set_xticklabels(tlabels)
+        a.minorticks_off()
+        a.set_xlabel("frame stiffness factor [-]")
+        a.grid(True, alpha=0.3)
+    ax[0].legend(fontsize=7.5)
+    fig.suptitle(title or "Contact-force quality over statistically equivalent roads",
+                 fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    from studies.pantograph_contact import save_png_pdf
+    return save_png_pdf(fig, path, dpi=110)
+
+
 def _grid_tyres(drive) -> str:
     """The tyre model of a grid's drives: ``"unilateral"`` only if every drive says so (grids
     made before the column existed were driven with bilateral tyres)."""
@@ -521,6 +720,8 @@ def _grid_tyres(drive) -> str:
 
 
 def _summary(table, cases, sweep, road_label: str) -> dict:
+    full = table
+    table = file_rows(table)
     drive = table[table["base"] == "drive"]
     still = table[table["base"] == "still"].iloc[0]
     c0 = cases[0]
@@ -566,6 +767,7 @@ def _summary(table, cases, sweep, road_label: str) -> dict:
                                  for b in bl},
         "inertia_scale_N_range": [float(drive["inertia_scale_N"].min()),
                                   float(drive["inertia_scale_N"].max())],
+        "realisations": realisation_summary(full),
         "n_cases": len(sweep.cases), "n_computed": sweep.n_computed,
         "n_cached": sweep.n_cached, "sweep_wall_s": round(sweep.wall_s, 2),
         "case_wall_s_sum": round(float(sum(w for w in sweep.case_wall_s if w)), 2)}
@@ -582,17 +784,23 @@ def _write_outputs(folder: Path, table, arrays, title: str) -> list[Path]:
                         force=arrays["force"].astype(np.float32),
                         base_z=arrays["base_z"].astype(np.float32),
                         frame=np.array(table["frame"], dtype=str),
+                        road=np.array(table["road"], dtype=str),
                         mount=table["mount"].to_numpy(float),
                         base=np.array(table["base"], dtype=str))
-    return plot_pantograph_chassis(data / "table.csv", figs / "contact_vs_stiffness.png",
-                                   title=title)
+    out = plot_pantograph_chassis(data / "table.csv", figs / "contact_vs_stiffness.png",
+                                  title=title)
+    if len(_roads(table)) > 1:
+        out += plot_realisations(data / "table.csv", figs / "realisations.png",
+                                 title=title.replace("vs frame", "over equivalent roads vs frame"))
+    return out
 
 
 def run_pantograph_chassis(road_path: str | Path, out_root: str | Path = "results", *,
                            run_dir: str | Path | None = None, frames=FRAME_FACTORS,
                            mounts=MOUNT_FACTORS, speed_kmh: float = 80.0,
                            duration: float = 30.0, line: str = "truck_ohl",
-                           pantograph: str = "truck", dt: float = 1e-3, scheduler: Any = None,
+                           pantograph: str = "truck", dt: float = 1e-3, seeds: int = 0,
+                           seed: int = 2026, scheduler: Any = None,
                            n_workers: int = 2, cache_dir: str | Path = ".eroad-cache",
                            progress: bool = True, command: list[str] | None = None) -> dict:
     """Run the study on a road and archive it.
@@ -610,6 +818,10 @@ def run_pantograph_chassis(road_path: str | Path, out_root: str | Path = "result
         :func:`eroad.archive.run_info`).
     frames, mounts, speed_kmh, duration, line, pantograph, dt
         See :func:`study_cases`.
+    seeds, seed
+        Statistically equivalent road realisations driven besides the file, and their
+        root seed (:func:`studies.chassis_study.road_specs`, as the chassis study); every
+        configuration is driven on every road, the still base once.
     scheduler, n_workers, cache_dir, progress
         Passed to :func:`studies.sweep.run_cases` (processes; ``n_workers`` 0/1: serial).
     command : list of str, optional
@@ -632,14 +844,25 @@ def run_pantograph_chassis(road_path: str | Path, out_root: str | Path = "result
     p = Path(road_path)
     if not p.is_file():
         raise EroadInputError(f"road file not found: {road_path}")
-    specs, _ = road_specs(p, n_seeds=0)
-    cases = study_cases(specs[0], frames=frames, mounts=mounts, speed_kmh=speed_kmh,
-                        duration=duration, line=line, pantograph=pantograph, dt=dt)
+    if int(seeds) < 0:
+        raise EroadInputError(f"--seeds {seeds}: must be >= 0")
+    specs, how = road_specs(p, n_seeds=int(seeds), seed=int(seed))
+    cases = []
+    for k, spec in enumerate(specs):
+        cs = study_cases(spec, frames=frames, mounts=mounts, speed_kmh=speed_kmh,
+                         duration=duration, line=line, pantograph=pantograph, dt=dt)
+        if k:
+            cs = [{**c, "road_label": spec["label"]} for c in cs[:-1]]
+        cases.append(cs)
+    # the road file's configurations, then each realisation's, the still base last
+    cases = cases[0][:-1] + [c for cs in cases[1:] for c in cs] + cases[0][-1:]
     config = {"road_file": str(p), "road_sha256": specs[0]["sha256"],
               "frames": [_frame_value(f) for f in frames],
               "mounts": [float(m) for m in mounts], "speed_kmh": float(speed_kmh),
               "duration_s": float(duration), "line": line, "pantograph": pantograph,
               "dt_s": float(dt), "t_start_s": T_START, "lowpass_hz": 20.0,
+              "road_realisations": int(seeds), "realisation_seed": int(seed),
+              "realisations_from": how,
               "force_bands_hz": [[lo, -1.0 if hi is None else hi] for lo, hi in FORCE_BANDS],
               "n_cases": len(cases), "case_function": "studies.pantograph_chassis:contact_case"}
     version = code_version()

@@ -173,3 +173,50 @@ def test_rough_road_drive_lifts_off_with_unilateral_tyres(tmp_path):
     assert tr["tyres"] == "unilateral"
     assert tr["tyre_lift_off_percent"] > 5.0 and tr["within_model_range"] is True
     assert "modelled" in tr["note"]
+
+
+def test_grid_over_equivalent_roads(tiny, capsys):
+    """``seeds=1``: every configuration is driven on the road file and on one statistically
+    equivalent realisation (its own phases), the still base once. The road file's rows are
+    the tiny study's (from the cache, bit for bit), so the figure and the top-level summary
+    do not move; the realisation's rows differ (another road), and the summary pairs each
+    configuration with the nominal one on the same road. Bad --seeds: one line, no run."""
+    s1, t1, out, road = tiny
+    s = run_pantograph_chassis(road, out, run_dir=out / "run2", frames=(1.0, "rigid"),
+                               mounts=(1.0,), duration=4.0, seeds=1, n_workers=0,
+                               cache_dir=out / "cache", progress=False, command=["test"])
+    t = pd.read_csv(out / "run2" / "data" / "table.csv", dtype={"frame": str})
+    assert list(t["road"]) == ["road file"] * 2 + ["realisation 1"] * 2 + ["road file"]
+    assert list(t["base"]) == ["drive"] * 4 + ["still"]
+    assert s["n_cached"] == 3 and s["n_computed"] == 2
+    f = t[t["road"] == "road file"].reset_index(drop=True)
+    assert f["sd_N"].tolist() == t1["sd_N"].tolist()
+    assert s["sd_N_range"] == s1["sd_N_range"]
+    real = t[t["road"] == "realisation 1"]
+    # another road: its base motion and sd differ from the file's by more than round-off
+    assert np.all(np.abs(real["base_z_rms_mm"].to_numpy() - f["base_z_rms_mm"][:2].to_numpy())
+                  > 1e-3 * f["base_z_rms_mm"][:2].to_numpy())
+    R = s["realisations"]
+    assert R["n_roads"] == 2 and R["roads"] == ["road file", "realisation 1"]
+    assert R["nominal_configuration"] == {"frame": "1.0", "mount": 1.0}
+    cfg = {c["frame"]: c for c in R["per_configuration"]}
+    assert cfg["1.0"]["paired_sd_N"] == [0.0, 0.0]
+    for k, rd in enumerate(R["roads"]):
+        g = t[(t["road"] == rd) & (t["base"] == "drive")].set_index("frame")
+        # table.csv keeps 6 significant digits (float_format %.6g): ~1e-5 N at 10-20 N
+        assert cfg["rigid"]["paired_sd_N"][k] == pytest.approx(
+            g.loc["rigid", "sd_N"] - g.loc["1.0", "sd_N"], abs=1e-4)
+        assert R["per_road"][rd]["sd_N_range"] == pytest.approx(
+            [g["sd_N"].min(), g["sd_N"].max()], abs=1e-4)
+    assert R["road_span_N"][1] == pytest.approx(max(
+        abs(g["sd_N"].iloc[0] - g["sd_N"].iloc[1])
+        for _, g in t[t["base"] == "drive"].groupby("frame")), abs=1e-4)
+    run = Path(s["path"])
+    assert (run / "figures" / "realisations.png").is_file()
+    assert "| rigid | 1 |" in (run / "data" / "table.md").read_text().split("Every road")[1]
+    with pytest.raises(SystemExit) as ex:   # argparse: usage line, one error line, exit 2
+        main(["pantograph-contact", "--road", str(road), "--out", str(out / "x"),
+              "--chassis-grid", "--seeds", "-1"])
+    err = capsys.readouterr().err
+    assert ex.value.code == 2 and "--seeds: '-1' must be >= 0" in err and "Traceback" not in err
+    assert not (out / "x").exists()
