@@ -220,6 +220,24 @@ SIGNATURE_NULL_LEVEL = 0.95
 #: road: their own scatter over 4 road phases spans 0.6-5.4, so the bound reaches 8-9) where the
 #: fixed threshold names 1 (docs/diagnosis.md, "Signature held to what a correct model reaches")
 SIGNATURE_USE_NULL = False
+#: corroborated signature: where the chosen (single-input) signature disagrees at the fixed
+#: threshold, does it still agree when BOTH (a) its mean z^2 lies within what the candidate
+#: model reaches against its own records on other road phases (:func:`signature_threshold`)
+#: and (b) the two-input signature, which the road's cross-track coherence does not enter,
+#: agrees at the fixed thresholds (:func:`signature_agrees`)?  Such a name is never "clear"
+#: and never ``identified`` (see :func:`decide`).
+#: Why (2026-11-25): blind nominal case 2 of seed 19 (leaf friction 4009 N, calibrated 4394 N,
+#: 89 % of the gap explained) fails the single-input test at 3.99 while the calibrated model
+#: scores 2.5-3.7 against itself (threshold 2: a right model fails it there), and its two-input
+#: transmissibility goes 19.8 -> 3.04.  Re-decided on the 45 saved blind summaries that hold
+#: both records: 2 drives gain the right name (leaf friction, one per family), none changes
+#: otherwise; with mere two-input agreement instead of positive evidence 3 wrong names were
+#: added (sensor -> tyre enveloping, speed scale and a sensor on no-effect drives of the
+#: independent truck: effects that leave the transmissibility where it was).
+SIGNATURE_CORROBORATE = True
+#: share of the nominal model's two-input excess (mean z^2 - 1) the candidate must remove to
+#: corroborate (positive evidence, not mere agreement; as SIGNATURE_STRONG)
+CORROBORATE_SHARE = 0.5
 
 
 def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_MAX,
@@ -348,7 +366,8 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
            signature_max: float = SIGNATURE_CHI2_MAX,
            signature_share: float = SIGNATURE_SHARE_MIN,
            signature_method: str = SIGNATURE_METHOD,
-           signature_null: bool = SIGNATURE_USE_NULL) -> dict:
+           signature_null: bool = SIGNATURE_USE_NULL,
+           corroborate: bool = SIGNATURE_CORROBORATE) -> dict:
     """Verdict, confidence, reason and what is left, from a diagnosis summary.
 
     Reads ``summary["ranking"]`` (entries, accepted first), ``summary["ranking_decision"]``
@@ -375,7 +394,8 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     win = next((e for e in ranking if e.get("effect") == rv and e.get("accepted")), None)
     thresholds = {"share_min": share_min, "signature_chi2_max": signature_max,
                   "signature_share_min": signature_share, "edge_tol": EDGE_TOL,
-                  "signature_method": signature_method, "signature_null": bool(signature_null)}
+                  "signature_method": signature_method, "signature_null": bool(signature_null),
+                  "corroborate": bool(corroborate)}
     sig, sig_method = chosen_signature(summary, signature_method)
     base = {"explained_share": None, "closest": None, "edge": [], "signature_agrees": None,
             "signature_method": sig_method if sig else None, "identified": False,
@@ -403,8 +423,22 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
             else "axle-to-body transmissibility")
     sig_max = signature_threshold(sig, signature_max) if signature_null else float(signature_max)
     agrees = signature_agrees(c0, c1, sig_max, signature_share)
+    corroborated = False
+    if agrees is False and corroborate and sig_method == "single_input":
+        s2 = summary.get("signature_two_input") or {}
+        own = signature_threshold(sig, signature_max)
+        d0, d1 = s2.get("chi2_nominal"), s2.get("chi2_model")
+        # positive evidence: the nominal model's two-input transmissibility is off and the
+        # candidate removes at least CORROBORATE_SHARE of its excess (an effect that acts
+        # on axle and body alike leaves it where it was and corroborates nothing)
+        a2 = bool((s2.get("n_cells") or 0) > 0 and d0 is not None and d1 is not None
+                  and d0 > signature_max and (d0 - d1) / (d0 - 1.0) >= CORROBORATE_SHARE)
+        if sig.get("chi2_correct_model") and c1 is not None and c1 <= own and a2:
+            agrees, corroborated = True, True
+            sig_max = own
     out = dict(base, explained_share=_f(share), closest=win["effect"], edge=edges,
-               signature_agrees=agrees, signature_max=_f(sig_max), residual=residual(summary, win))
+               signature_agrees=agrees, signature_max=_f(sig_max), residual=residual(summary, win),
+               signature_corroborated=corroborated)
     remainder = ""
     if agrees and c1 is not None and c1 > sig_max:
         remainder = (f"; its {what} moves towards the measurement (mean z^2 {c0:.2g} "
@@ -467,6 +501,14 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
                    f"{sig_max:.2g} asked): the effect does not bring it nearer, so the "
                    f"signature cannot confirm it, and what keeps the transmissibility off (a difference "
                    f"beyond it, or this drive's noise) is not known -- not 'clear', no correction")
+    if corroborated:
+        s2 = summary["signature_two_input"]
+        conf = "ambiguous"
+        reason += (f"; its single-input transmissibility (mean z^2 {c1:.2g}) is off by the fixed "
+                   f"threshold ({signature_max:.2g}) but within what the model reaches against "
+                   f"itself on other road phases (up to {sig_max:.2g}), and its two-input "
+                   f"transmissibility agrees (mean z^2 {s2['chi2_nominal']:.2g} -> "
+                   f"{s2['chi2_model']:.2g}): corroborated, not 'clear', no correction")
     z_abs = improvement_z(win)
     weak = z_abs is not None and z_abs < CLEAR_Z_MIN
     if weak:
@@ -487,7 +529,8 @@ def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
     # correct: what a correction may use
     return dict(out, verdict=rv, confidence=conf, reason=reason,
                 identified=bool(rd.get("confidence") == "clear" and not edges and gap_present
-                                and not weak and not on_gap_alone and not on_signature))
+                                and not weak and not on_gap_alone and not on_signature
+                                and not corroborated))
 
 
 def improvement_z(entry: Mapping) -> float | None:
