@@ -1263,19 +1263,35 @@ def two_input_or_none(measured, simulated):
     return transmissibility_two_input(measured, simulated)
 
 
+def close_rival(ranking):
+    """The best accepted rival that shares no effect with the ranking's winner and comes
+    within the nominal-vs-nominal gap's sd of its held-out gap (what makes the ranking's
+    confidence "ambiguous", :func:`diagnosis.which._decide`), or None."""
+    win = ranking.winner
+    if win is None:
+        return None
+    names = set(win.effect.split("+"))
+    for e in ranking.entries:
+        if (e is not win and e.accepted and not names & set(e.effect.split("+"))
+                and e.heldout_gap_after - win.heldout_gap_after < ranking.null.std):
+            return e
+    return None
+
+
 def _winner_signature(model: TruckModel, sig: Signals, sim: Signals, tr, tr2, ranking, seed: int,
-                      executor=None):
-    """The ranking winner's signature records (single- and two-input, each with what the
-    winner reaches against its own records, :func:`signature_null`) and the seconds taken;
-    ``(None, None, None)`` without a winner.  The winner's record (road phase ``seed + 1``)
-    and its surrogates run on ``executor`` when given."""
+                      executor=None, entry=None):
+    """The ranking winner's (or ``entry``'s) signature records (single- and two-input, each
+    with what the model reaches against its own records, :func:`signature_null`) and the
+    seconds taken; ``(None, None, None)`` without a winner.  The model's record (road phase
+    ``seed + 1``) and its surrogates run on ``executor`` when given."""
     from diagnosis.compare import transmissibility
     from diagnosis.verdict import signature
 
-    if ranking.winner is None:
+    entry = entry if entry is not None else ranking.winner
+    if entry is None:
         return None, None, None
     t = _time.perf_counter()
-    eff = ranking.winner.effects
+    eff = entry.effects
     T = sig.time.size / sig.fs
     seeds = [seed + 1] + [seed + 2 + j for j in range(SIGNATURE_NULL_N)]
     if executor is not None:
@@ -1284,13 +1300,13 @@ def _winner_signature(model: TruckModel, sig: Signals, sim: Signals, tr, tr2, ra
     else:
         runs = [model.run(eff, 0.0, T, sd) for sd in seeds]
     simw = Signals(sig.time, model.add_noise(runs[0], seeds[0]), dict(sig.units), sig.speed,
-                   {"model": ranking.winner.effect})
+                   {"model": entry.effect})
     null = signature_null(model, sig, simw, runs[1:], seeds[1:])
-    sig_w = signature(ranking.winner.effect, tr, transmissibility(sig, simw), null=null["single_input"])
+    sig_w = signature(entry.effect, tr, transmissibility(sig, simw), null=null["single_input"])
     sig_w2 = None
     tr2w = two_input_or_none(sig, simw) if tr2 is not None else None
     if tr2w is not None:
-        sig_w2 = signature(ranking.winner.effect, tr2, tr2w, method="two_input", null=null["two_input"])
+        sig_w2 = signature(entry.effect, tr2, tr2w, method="two_input", null=null["two_input"])
     return sig_w, sig_w2, _time.perf_counter() - t
 
 
@@ -1414,6 +1430,15 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         sig_w, sig_w2, t_sig = _winner_signature(model, sig, sim, tr, tr2, ranking, seed, ex)
         if t_sig is not None:
             timing["signature_s"] = t_sig
+        # a rival within noise of the winner's gap: its signature too, so the verdict can
+        # break the tie on the transmissibility (diagnosis.verdict.decide, tie_break)
+        rival = close_rival(ranking)
+        sig_r = None
+        if rival is not None:
+            r1, r2, t_r = _winner_signature(model, sig, sim, tr, tr2, ranking, seed, ex,
+                                            entry=rival)
+            sig_r = {"effect": rival.effect, "single_input": r1, "two_input": r2}
+            timing["signature_rival_s"] = t_r
     finally:
         if ex is not None:
             ex.shutdown()
@@ -1449,7 +1474,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     }
     write_report(out, localization=loc, transmissibility=tr, front_rear=fr, shape=sh,
                  ranking=ranking, meta=meta, force=force, signature=sig_w,
-                 transmissibility_two_input=tr2, signature_two_input=sig_w2)
+                 transmissibility_two_input=tr2, signature_two_input=sig_w2,
+                 signature_rival=sig_r)
     write_run_json(out, finish_run_info(record, "complete", wall_s=_time.perf_counter() - wall0))
     summary = json.loads((out / "summary.json").read_text())
     progress(f"verdict: {summary['verdict']} ({summary['verdict_confidence']}); "

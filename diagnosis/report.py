@@ -64,7 +64,8 @@ def jsonable(obj: Any) -> Any:
 
 def build_summary(localization=None, *, transmissibility=None, front_rear=None, shape=None,
                   ranking=None, meta: Mapping | None = None, signature=None,
-                  transmissibility_two_input=None, signature_two_input=None) -> dict:
+                  transmissibility_two_input=None, signature_two_input=None,
+                  signature_rival=None) -> dict:
     """Machine-readable summary of a diagnosis.
 
     Parameters
@@ -81,6 +82,10 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
     transmissibility_two_input : diagnosis.compare.TwoInputTransmissibility, optional
     signature_two_input : diagnosis.verdict.Signature, optional
         The same with the two-input transmissibility (``method="two_input"``).
+    signature_rival : dict, optional
+        ``{"effect", "single_input", "two_input"}`` (Signatures or None): the same for the
+        rival that came within noise of the winner's gap (``pipeline.close_rival``); the
+        verdict breaks such a tie on it.
 
     The verdict is :func:`diagnosis.verdict.decide` on this summary (the ranking's own
     decision is kept under ``ranking_decision``).
@@ -155,6 +160,11 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
             s["signature"] = signature.record()
         if signature_two_input is not None:
             s["signature_two_input"] = signature_two_input.record()
+        if signature_rival is not None:
+            s["signature_rival"] = {
+                "effect": signature_rival["effect"],
+                **{k: (None if signature_rival.get(k) is None else signature_rival[k].record())
+                   for k in ("single_input", "two_input")}}
         s = jsonable(s)
         d = decide(s)
         s["verdict"], s["verdict_confidence"], s["verdict_reason"] = (d["verdict"], d["confidence"],
@@ -569,7 +579,10 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
     if H:
         L.append("## How far\n")
         L.append(f"Held-out gap per band before and after {H['effect']}"
-                 + ("" if H["is_verdict"] else " (best candidate, NOT accepted)") + ".\n")
+                 + ("" if H["is_verdict"] else
+                    f" (the ranking's best; the verdict names {v}, see Verdict)"
+                    if v not in ("none", "unexplained") else
+                    " (best candidate, NOT accepted)") + ".\n")
         if "shrink" in figures:
             L.append(f"![shrink per band]({figures['shrink']})\n")
     L.append("## Method\n")
@@ -600,7 +613,7 @@ def _terms_text(settings: Mapping) -> str:
 def write_report(out: str | os.PathLike, *, localization=None, transmissibility=None,
                  front_rear=None, shape=None, ranking=None, meta: Mapping | None = None,
                  force: bool = False, signature=None, transmissibility_two_input=None,
-                 signature_two_input=None) -> Path:
+                 signature_two_input=None, signature_rival=None) -> Path:
     """Write ``summary.json``, ``figures/*.png`` and ``report.md`` into ``out``.
 
     Parameters
@@ -608,7 +621,7 @@ def write_report(out: str | os.PathLike, *, localization=None, transmissibility=
     out : path
         Run folder; refused if it exists and is not empty unless ``force``.
     localization, transmissibility, front_rear, shape, ranking, meta, signature,
-    transmissibility_two_input, signature_two_input
+    transmissibility_two_input, signature_two_input, signature_rival
         As for :func:`build_summary`.
     force : bool
         Replace an existing non-empty ``out`` (only after the new one is complete).
@@ -624,7 +637,8 @@ def write_report(out: str | os.PathLike, *, localization=None, transmissibility=
     summary = build_summary(localization, transmissibility=transmissibility, front_rear=front_rear,
                             shape=shape, ranking=ranking, meta=meta, signature=signature,
                             transmissibility_two_input=transmissibility_two_input,
-                            signature_two_input=signature_two_input)
+                            signature_two_input=signature_two_input,
+                            signature_rival=signature_rival)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
     try:

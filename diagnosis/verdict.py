@@ -238,6 +238,11 @@ SIGNATURE_CORROBORATE = True
 #: share of the nominal model's two-input excess (mean z^2 - 1) the candidate must remove to
 #: corroborate (positive evidence, not mere agreement; as SIGNATURE_STRONG)
 CORROBORATE_SHARE = 0.5
+#: a near tie of the gap between the ranking's winner and a rival is broken by the
+#: transmissibility (:func:`decide`): set a priori (2026-11-25, no saved summary holds a
+#: rival's signature), a rival 30 % nearer the measurement in mean z^2; checked blind after
+SIGNATURE_TIE_BREAK = True
+TIE_RATIO = 0.7
 
 
 def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_MAX,
@@ -362,12 +367,66 @@ def signature_agrees(c0, c1, signature_max: float = SIGNATURE_CHI2_MAX,
                 and (c0 - c1) / (c0 - 1.0) >= signature_share)
 
 
-def decide(summary: Mapping, *, share_min: float = SHARE_MIN,
-           signature_max: float = SIGNATURE_CHI2_MAX,
-           signature_share: float = SIGNATURE_SHARE_MIN,
-           signature_method: str = SIGNATURE_METHOD,
-           signature_null: bool = SIGNATURE_USE_NULL,
-           corroborate: bool = SIGNATURE_CORROBORATE) -> dict:
+def _signature_distance(single: Mapping | None, two: Mapping | None, method: str):
+    """(method, mean z^2 of the model) a tie between two candidates is judged on: the
+    two-input record where ``method`` is ``"two_input"`` and it has cells, else the single
+    input; None where the record lacks the number."""
+    if method == "two_input" and two and (two.get("n_cells") or 0) > 0 \
+            and two.get("chi2_model") is not None:
+        return float(two["chi2_model"])
+    if single and single.get("chi2_model") is not None:
+        return float(single["chi2_model"])
+    return None
+
+
+def decide(summary: Mapping, *, tie_break: bool = SIGNATURE_TIE_BREAK, **kw) -> dict:
+    """Verdict, confidence, reason and what is left, from a diagnosis summary: see
+    :func:`decide_one` for the rules and the keywords.
+
+    With ``tie_break`` (``SIGNATURE_TIE_BREAK``): where the ranking's winner is named but a
+    rival came within noise of its held-out gap (the ranking's confidence "ambiguous") and
+    the summary holds that rival's signature (``signature_rival``), the rival is named
+    instead when it passes every test too and its transmissibility is nearer the
+    measurement: mean z^2 at most ``TIE_RATIO`` times the winner's, two-input where both
+    have it.  The gap cannot tell the two apart, the road-independent statistic can.  Only
+    ever one name for another: a drive answered ``none`` or ``unexplained`` stays so.
+    """
+    d = decide_one(summary, **kw)
+    R = summary.get("signature_rival") or {}
+    rd = summary.get("ranking_decision") or {}
+    if not (tie_break and R.get("effect") and d["verdict"] not in ("none", "unexplained")
+            and d["verdict"] == rd.get("verdict") and rd.get("confidence") == "ambiguous"):
+        return d
+    both = bool((summary.get("signature_two_input") or {}).get("n_cells")
+                and (R.get("two_input") or {}).get("n_cells"))
+    method = "two_input" if both else "single_input"
+    dw = _signature_distance(summary.get("signature"), summary.get("signature_two_input"), method)
+    dr = _signature_distance(R.get("single_input"), R.get("two_input"), method)
+    if dw is None or dr is None or not dr <= TIE_RATIO * dw:
+        return dict(d, tie_break={"rival": R["effect"], "method": method, "winner_chi2": dw,
+                                  "rival_chi2": dr, "swapped": False})
+    view = dict(summary, signature=R.get("single_input") or {},
+                signature_two_input=R.get("two_input") or {},
+                ranking_decision=dict(rd, verdict=R["effect"]))
+    d2 = decide_one(view, **kw)
+    info = {"rival": R["effect"], "method": method, "winner_chi2": dw, "rival_chi2": dr,
+            "swapped": d2["verdict"] == R["effect"]}
+    if not info["swapped"]:
+        return dict(d, tie_break=info)
+    what = "two-input" if method == "two_input" else "single-input"
+    return dict(d2, tie_break=info, identified=False, confidence="ambiguous",
+                reason=(f"{d2['reason']}; {rd['verdict']} fits the held-out gap as well (within "
+                        f"noise), but {R['effect']}'s {what} axle-to-body transmissibility is "
+                        f"nearer the measurement (mean z^2 {dr:.2g} against {dw:.2g}), so "
+                        f"{R['effect']} is named -- not 'clear', no correction"))
+
+
+def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
+               signature_max: float = SIGNATURE_CHI2_MAX,
+               signature_share: float = SIGNATURE_SHARE_MIN,
+               signature_method: str = SIGNATURE_METHOD,
+               signature_null: bool = SIGNATURE_USE_NULL,
+               corroborate: bool = SIGNATURE_CORROBORATE) -> dict:
     """Verdict, confidence, reason and what is left, from a diagnosis summary.
 
     Reads ``summary["ranking"]`` (entries, accepted first), ``summary["ranking_decision"]``

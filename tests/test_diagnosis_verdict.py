@@ -250,3 +250,44 @@ def test_corroborated_signature():
         assert d["verdict"] == "unexplained" and d["signature_corroborated"] is False
     d = decide(case(), corroborate=False)
     assert d["verdict"] == "unexplained"
+
+
+def test_tie_broken_by_the_transmissibility():
+    """A near tie of the gap (blind case 2 of the independent truck, seed 17: payload -9.7 t,
+    leaf friction at 0.446 and payload at 0.453 held-out gap, within the 0.05 noise sd) is
+    broken by the two-input transmissibility when the rival's is at most TIE_RATIO of the
+    winner's and the rival passes every test itself; never 'clear', never identified. A
+    drive the winner does not explain stays unexplained (no name is created), a rival that
+    is not nearer keeps the winner, and ``tie_break=False`` is the rule before."""
+    from diagnosis.verdict import TIE_RATIO
+
+    def case(rival_two=2.0, winner_c1=1.1, rival_accepted=True):
+        s = _summary(after=0.446, rconf="ambiguous", chi2=(9.4, winner_c1))
+        s["ranking"].insert(1, {"effect": "payload", "accepted": rival_accepted,
+                                "heldout_gap_before": 1.0, "heldout_gap_after": 0.453,
+                                "parameters": {"payload": {"mass": -11116.0}},
+                                "per_band_after": [0.5, 0.9, 0.3]})
+        s["meta"]["search_ranges"]["payload"] = {"mass": [-14000.0, 14000.0, False]}
+        s["signature_two_input"] = {"model": "leaf_friction", "chi2_nominal": 14.8,
+                                    "chi2_model": 7.1, "n_cells": 29}
+        s["signature_rival"] = {
+            "effect": "payload",
+            "single_input": {"model": "payload", "chi2_nominal": 9.4, "chi2_model": 1.2,
+                             "n_cells": 40},
+            "two_input": {"model": "payload", "chi2_nominal": 14.8, "chi2_model": rival_two,
+                          "n_cells": 29}}
+        return s
+
+    d = decide(case())
+    assert (d["verdict"], d["confidence"], d["identified"]) == ("payload", "ambiguous", False)
+    assert d["tie_break"]["swapped"] is True and d["tie_break"]["method"] == "two_input"
+    assert "nearer the measurement" in d["reason"]
+    d = decide(case(rival_two=TIE_RATIO * 7.1 * 1.05))
+    assert d["verdict"] == "leaf_friction" and d["tie_break"]["swapped"] is False
+    assert decide(case(), tie_break=False)["verdict"] == "leaf_friction"
+    # the winner fails its signature: unexplained, and the rival cannot turn it into a name
+    d = decide(case(winner_c1=9.0))
+    assert d["verdict"] == "unexplained" and "tie_break" not in d
+    # a rival the ranking did not accept is never named
+    s = case(rival_accepted=False)
+    assert decide(s)["verdict"] == "leaf_friction"
