@@ -285,3 +285,29 @@ def test_bad_input(lms):
         lm.response_psd({"Gq_n0": 1e-5, "n0": 0.1}, 10.0, [1.0])
     with pytest.raises(EroadInputError, match="frequencies"):
         lm.frf([-1.0])
+
+
+def test_frf_memo_and_broadcast_coherence(lms):
+    """Speed without a change of result (2026-11-25): a repeated FRF comes from the model's
+    memo (same object, read-only), and a coherence callable that
+    broadcasts is called once over the grid with the per-frequency call's result."""
+    lm = next(iter(lms.values()))
+    f = np.geomspace(0.5, 40.0, 200)
+    h1 = lm.frf(f)
+    h2 = lm.frf(f)
+    assert h1 is h2 and not h1.flags.writeable
+    assert np.array_equal(h1, lm.frf(f.copy()))
+    road = {"Gq_n0": 256e-6, "w": 2.0, "nmin": 0.011, "nmax": 5.0}
+    calls = []
+
+    def gam(n, dy):
+        calls.append(np.ndim(n))
+        return surface_coherence(n, dy, 2.0, 0.5)
+
+    def gam_scalar_only(n, dy):
+        return surface_coherence(float(n), dy, 2.0, 0.5)
+
+    a = lm.road_cross_spectrum(road, 12.0, f, gam)
+    b = lm.road_cross_spectrum(road, 12.0, f, gam_scalar_only)
+    assert calls == [3]
+    assert np.allclose(a, b, rtol=1e-12, atol=0.0)

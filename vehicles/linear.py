@@ -249,6 +249,12 @@ class LinearModel:
         """
         f = _freqs(freqs)
         outs = self._select(channels)
+        # the same grid and channels are asked for again and again (a response RMS per
+        # lateral-coherence alternative, per segment): the last few FRFs are kept
+        key = (f.tobytes(), tuple(o.name for o in outs))
+        cache = self.__dict__.setdefault("_frf_cache", {})
+        if key in cache:
+            return cache[key]
         X = self.coordinate_frf(f)
         C = np.array([o.row for o in outs])
         H = np.einsum("on,fnc->foc", C, X)
@@ -256,6 +262,10 @@ class LinearModel:
         for j, o in enumerate(outs):
             if o.order == 2:
                 H[:, j, :] *= -w2[:, None]
+        H.flags.writeable = False
+        if len(cache) >= 8:
+            cache.pop(next(iter(cache)))
+        cache[key] = H
         return H
 
     def track_frf(self, freqs, speed: float, channels=None) -> np.ndarray:
@@ -317,9 +327,16 @@ class LinearModel:
         sides = np.array([c["side"] for c in self.contacts])
         dy = np.abs(ys[:, None] - ys[None, :])
         if callable(coherence):
-            gam = np.empty((f.size,) + dy.shape)
-            for i, ni in enumerate(n):
-                gam[i] = np.asarray(coherence(ni, dy), float)
+            # one broadcast call (n (nf, 1, 1), dy (1, nc, nc)) where the callable allows
+            # it, else one call per frequency
+            try:
+                gam = np.asarray(coherence(n[:, None, None], dy[None, :, :]), float)
+            except (TypeError, ValueError):
+                gam = None
+            if gam is None or gam.shape != (f.size,) + dy.shape:
+                gam = np.empty((f.size,) + dy.shape)
+                for i, ni in enumerate(n):
+                    gam[i] = np.asarray(coherence(ni, dy), float)
         elif coherence == "correlated":
             gam = np.ones((f.size,) + dy.shape)
         elif coherence == "independent":
@@ -360,7 +377,8 @@ class LinearModel:
         outs = self._select(channels)
         H = self.frf(f, [o.name for o in outs])
         S = self.road_cross_spectrum(road, speed, f, coherence)
-        P = np.einsum("foc,fcd,fod->fo", H, S, H.conj()).real
+        # P[f, o] = sum_cd H[f, o, c] S[f, c, d] conj(H[f, o, d]) as one batched product
+        P = np.einsum("fod,fod->fo", H @ S, H.conj()).real
         return {o.name: np.maximum(P[:, j], 0.0) for j, o in enumerate(outs)}
 
     def response_rms(self, road, speed: float, coherence="surface", channels=None,
