@@ -687,8 +687,9 @@ def plot_realisations(table_csv: str | Path, path: str | Path, *, title: str = "
                     f"{chassis:.2f} N,\none configuration over the roads <= {road:.2f} N",
                     fontsize=9.5)
     ax[1].axhline(0.0, color="0.5", lw=0.8)
-    ax[1].set_ylabel(f"sd minus sd(frame {nom[0]}, mounts x{nom[1]:g}) on the same road [N]")
-    ax[1].set_title("(b) paired on the road: what the chassis changes", fontsize=9.5)
+    ax[1].set_ylabel("sd minus the nominal configuration's [N]")
+    ax[1].set_title(f"(b) paired on each road against frame {nom[0]}, mounts x{nom[1]:g}:\n"
+                    "what the chassis changes", fontsize=9.5)
     ax[2].set_ylabel("contact loss [% of time]")
     lmax = float(drive["loss_percent"].max())
     ax[2].set_title(f"(c) contact loss (largest {lmax:.2f} %)", fontsize=9.5)
@@ -703,10 +704,11 @@ def plot_realisations(table_csv: str | Path, path: str | Path, *, title: str = "
         a.minorticks_off()
         a.set_xlabel("frame stiffness factor [-]")
         a.grid(True, alpha=0.3)
-    ax[0].legend(fontsize=7.5)
+    h, lab = ax[0].get_legend_handles_labels()
+    fig.legend(h, lab, loc="lower center", ncol=len(lab), fontsize=8, frameon=False)
     fig.suptitle(title or "Contact-force quality over statistically equivalent roads",
                  fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    fig.tight_layout(rect=(0, 0.06, 1, 0.95))
     from studies.pantograph_contact import save_png_pdf
     return save_png_pdf(fig, path, dpi=110)
 
