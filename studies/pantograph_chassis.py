@@ -522,6 +522,16 @@ def _frame_x(frames: list[str]) -> tuple[dict, list[float], list[str]]:
     return pos, ticks, labels
 
 
+def _frame_axis(a, ticks, labels) -> None:
+    """A log frame-factor x axis with the grid's factors as ticks (rigid last)."""
+    a.set_xscale("log")
+    a.set_xticks(ticks)
+    a.set_xticklabels(labels)
+    a.minorticks_off()
+    a.set_xlabel("frame stiffness factor [-]")
+    a.grid(True, alpha=0.3)
+
+
 def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: str = ""
                             ) -> list[Path]:
     """The study figure from the saved table (``table.csv``): contact-force sd, contact
@@ -546,12 +556,7 @@ def plot_pantograph_chassis(table_csv: str | Path, path: str | Path, *, title: s
     fig, ax = plt.subplots(2, 2, figsize=(12, 8.5))
 
     def frame_axis(a):
-        a.set_xscale("log")
-        a.set_xticks(ticks)
-        a.set_xticklabels(tlabels)
-        a.minorticks_off()
-        a.set_xlabel("frame stiffness factor [-]")
-        a.grid(True, alpha=0.3)
+        _frame_axis(a, ticks, tlabels)
 
     for m in mounts:
         g = drive[drive["mount"] == m].sort_values("x")
@@ -698,12 +703,7 @@ def plot_realisations(table_csv: str | Path, path: str | Path, *, title: str = "
         ax[2].text(0.5, 0.2, "no contact loss on any road", ha="center",
                    transform=ax[2].transAxes, fontsize=10)
     for a in ax:
-        a.set_xscale("log")
-        a.set_xticks(ticks)
-        a.set_xticklabels(tlabels)
-        a.minorticks_off()
-        a.set_xlabel("frame stiffness factor [-]")
-        a.grid(True, alpha=0.3)
+        _frame_axis(a, ticks, tlabels)
     h, lab = ax[0].get_legend_handles_labels()
     fig.legend(h, lab, loc="lower center", ncol=len(lab), fontsize=8, frameon=False)
     fig.suptitle(title or "Contact-force quality over statistically equivalent roads",
