@@ -326,14 +326,20 @@ class LinearModel:
         xs = np.array([c["x"] for c in self.contacts])
         sides = np.array([c["side"] for c in self.contacts])
         dy = np.abs(ys[:, None] - ys[None, :])
+        # a coherence is a function of (n, dy) pair by pair: evaluated on the few distinct
+        # track distances (an 8x4 truck's 16 tyres have 7) and gathered into the matrix
+        udy, inv = np.unique(dy, return_inverse=True)
+        inv = inv.reshape(dy.shape)
         if callable(coherence):
-            # one broadcast call (n (nf, 1, 1), dy (1, nc, nc)) where the callable allows
-            # it, else one call per frequency
+            # one broadcast call (n (nf, 1), distinct dy (1, K)) where the callable allows
+            # it, else one call per frequency on the whole matrix
             try:
-                gam = np.asarray(coherence(n[:, None, None], dy[None, :, :]), float)
+                g = np.asarray(coherence(n[:, None], udy[None, :]), float)
             except (TypeError, ValueError):
-                gam = None
-            if gam is None or gam.shape != (f.size,) + dy.shape:
+                g = None
+            if g is not None and g.shape == (f.size, udy.size):
+                gam = g[:, inv]
+            else:
                 gam = np.empty((f.size,) + dy.shape)
                 for i, ni in enumerate(n):
                     gam[i] = np.asarray(coherence(ni, dy), float)
@@ -344,7 +350,7 @@ class LinearModel:
                                   (f.size,) + dy.shape).copy()
         elif coherence == "surface":
             p = _road_dict(road)
-            gam = surface_coherence(n[:, None, None], dy[None, :, :], p["w"], p["lam"])
+            gam = surface_coherence(n[:, None], udy[None, :], p["w"], p["lam"])[:, inv]
         else:
             raise EroadInputError(f"unknown coherence model {coherence!r}; use one of "
                                   f"{', '.join(COHERENCE_MODELS)} or a callable gamma(n, dy)")
