@@ -40,7 +40,12 @@ Vocabulary
        model's -- with the ranking's own verdict clear; an effect acting on axle and body
        alike cannot move an off transmissibility.  And named on the signature: a winner that
        fails only 2. is still named (``ambiguous``, never ``identified``) when it removes at
-       least ``SIGNATURE_STRONG`` of the nominal model's transmissibility excess.  ``identified``
+       least ``SIGNATURE_STRONG`` of the nominal model's transmissibility excess.  And
+       corroborated (``SIGNATURE_CORROBORATE``): a single-input signature off by the fixed
+       threshold passes 3. when it lies within the candidate's own scatter and the two-input
+       one gives positive evidence (``ambiguous``, never ``identified``).  A near tie of the
+       gap with a rival is broken by the transmissibility (:func:`decide`,
+       ``SIGNATURE_TIE_BREAK``).  ``identified``
     (in the result) is True when the named effect's identity and value are not in doubt
     (no close rival, no range edge) even if a remainder keeps it from "clear": the
     closed loop (``diagnosis.closed_loop``) corrects with such an effect.  The front-to-rear delay and the amplitude distribution
@@ -224,8 +229,9 @@ SIGNATURE_USE_NULL = False
 #: threshold, does it still agree when BOTH (a) its mean z^2 lies within what the candidate
 #: model reaches against its own records on other road phases (:func:`signature_threshold`)
 #: and (b) the two-input signature, which the road's cross-track coherence does not enter,
-#: agrees at the fixed thresholds (:func:`signature_agrees`)?  Such a name is never "clear"
-#: and never ``identified`` (see :func:`decide`).
+#: gives positive evidence: the nominal model's is off (above ``SIGNATURE_CHI2_MAX``) and the
+#: candidate removes at least ``CORROBORATE_SHARE`` of its excess?  Such a name is never
+#: "clear" and never ``identified`` (see :func:`decide_one`).
 #: Why (2026-11-25): blind nominal case 2 of seed 19 (leaf friction 4009 N, calibrated 4394 N,
 #: 89 % of the gap explained) fails the single-input test at 3.99 while the calibrated model
 #: scores 2.5-3.7 against itself (threshold 2: a right model fails it there), and its two-input
