@@ -1264,21 +1264,18 @@ def two_input_or_none(measured, simulated):
 
 
 def close_rival(ranking):
-    """The best accepted rival that shares no effect with the ranking's winner and comes
-    within the nominal-vs-nominal gap's sd of its held-out gap (what makes the ranking's
-    confidence "ambiguous", :func:`diagnosis.which._decide`), or None."""
-    win = ranking.winner
-    if win is None:
+    """The best accepted rival that comes within noise of the ranking winner's held-out
+    gap (:func:`diagnosis.which.close_rivals`: what makes the ranking's confidence
+    "ambiguous"), or None."""
+    from diagnosis.which import close_rivals
+
+    if ranking.winner is None:
         return None
-    names = set(win.effect.split("+"))
-    for e in ranking.entries:
-        if (e is not win and e.accepted and not names & set(e.effect.split("+"))
-                and e.heldout_gap_after - win.heldout_gap_after < ranking.null.std):
-            return e
-    return None
+    return next((e for e in close_rivals(ranking.entries, ranking.winner, ranking.null.std)
+                 if e.accepted), None)
 
 
-def _winner_signature(model: TruckModel, sig: Signals, sim: Signals, tr, tr2, ranking, seed: int,
+def _model_signature(model: TruckModel, sig: Signals, sim: Signals, tr, tr2, ranking, seed: int,
                       executor=None, entry=None):
     """The ranking winner's (or ``entry``'s) signature records (single- and two-input, each
     with what the model reaches against its own records, :func:`signature_null`) and the
@@ -1427,7 +1424,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         # single-input ratio (``signature``) and the two-input estimate (``signature_two_input``,
         # where both sides are measured), each with what the winner reaches against itself;
         # the verdict uses diagnosis.verdict.SIGNATURE_METHOD
-        sig_w, sig_w2, t_sig = _winner_signature(model, sig, sim, tr, tr2, ranking, seed, ex)
+        sig_w, sig_w2, t_sig = _model_signature(model, sig, sim, tr, tr2, ranking, seed, ex)
         if t_sig is not None:
             timing["signature_s"] = t_sig
         # a rival within noise of the winner's gap: its signature too, so the verdict can
@@ -1435,7 +1432,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         rival = close_rival(ranking)
         sig_r = None
         if rival is not None:
-            r1, r2, t_r = _winner_signature(model, sig, sim, tr, tr2, ranking, seed, ex,
+            r1, r2, t_r = _model_signature(model, sig, sim, tr, tr2, ranking, seed, ex,
                                             entry=rival)
             sig_r = {"effect": rival.effect, "single_input": r1, "two_input": r2}
             timing["signature_rival_s"] = t_r

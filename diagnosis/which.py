@@ -1042,6 +1042,17 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                    gap_present, verdict, conf, reason, sc.ref_held.bands, settings)
 
 
+def close_rivals(entries, win: Entry, sd0: float) -> list:
+    """Entries that share no effect with the winner ``win`` and come within ``sd0`` (the
+    nominal-vs-nominal gap's sd) of its held-out gap: not clearly worse, so the winner is
+    not "clear".  The paired null is not the yardstick here: it describes models scored
+    against nominal data, and its spread grows with a model's distance from the nominal one
+    (a strong winner would make every rival "close")."""
+    names = set(win.effect.split("+"))
+    return [e for e in entries if e is not win and not names & set(e.effect.split("+"))
+            and e.heldout_gap_after - win.heldout_gap_after < sd0]
+
+
 def _decide(entries, before, null: NullReference, gap_present: bool, z_paired: float):
     """Sort the entries (accepted first, then by BIC) and give verdict, confidence, reason."""
     sd0 = null.std
@@ -1059,13 +1070,7 @@ def _decide(entries, before, null: NullReference, gap_present: bool, z_paired: f
                   f"with a lower BIC")
     else:
         verdict = win.effect
-        names = set(verdict.split("+"))
-        rivals = [e for e in entries if not names & set(e.effect.split("+"))]
-        # a rival within one sd of the nominal-vs-nominal gap (its road-phase scatter) is not
-        # clearly worse; the paired null is not the yardstick here: it describes models
-        # scored against nominal data, and its spread grows with a model's distance from
-        # the nominal one (a strong winner would make every rival "close")
-        close = [e for e in rivals if e.heldout_gap_after - win.heldout_gap_after < sd0]
+        close = close_rivals(entries, win, sd0)
         conf = "ambiguous" if close else "clear"
         reason = (f"{verdict} shrinks the held-out gap from {win.heldout_gap_before:.3g} to "
                   f"{win.heldout_gap_after:.3g} (improvement {win.improvement:.3g}, paired noise "

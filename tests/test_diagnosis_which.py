@@ -178,6 +178,15 @@ def test_two_folds_combine_the_held_out_evidence():
         if want != "none":
             w = r.winner
             assert w.null_sd < max(f.null_sd for x in rs for f in x.entries if f.effect == want)
+            # the rivals that make a winner "ambiguous" are the ones the reason names, and
+            # pipeline.close_rival (whose signature breaks a tie) is the best accepted one
+            from diagnosis.pipeline import close_rival
+            from diagnosis.which import close_rivals
+            close = close_rivals(r.entries, w, r.null.std)
+            assert (r.confidence == "ambiguous") == bool(close)
+            assert all(e.effect in r.reason for e in close)
+            acc = [e for e in close if e.accepted]
+            assert close_rival(r) is (acc[0] if acc else None)
         # given the candidates, the reported calibration is the folds' mean in the search's
         # unit coordinates: the geometric mean for a log-searched parameter, the arithmetic
         # mean for a linear one; without them, the first fold's (as before)
