@@ -450,7 +450,6 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from pathlib import Path
 
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
     a1.plot(time, 1e3 * np.asarray(signal), lw=0.5, color="0.3")
@@ -479,8 +478,6 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
              "'segment' column), where each segment's fitted class and parameters are.",
              fontsize=7, color="0.3")
     fig.tight_layout(rect=(0, 0.02, 1, 1))
-    paths = [Path(p) for p in path] if isinstance(path, (list, tuple)) else [Path(path)]
-    for p in paths:       # one drawing, every format asked for
-        fig.savefig(p, dpi=150)
-    plt.close(fig)
-    return paths[0]
+    from eroad.figures import save_figure
+
+    return save_figure(fig, path, dpi=150)[0]

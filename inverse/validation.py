@@ -147,7 +147,6 @@ def plot_time_compare(time, measured: dict, simulated: dict, channels, path, win
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from pathlib import Path
 
     t = np.asarray(time)
     sel = slice(None) if window is None else (t >= window[0]) & (t <= window[1])
@@ -166,11 +165,9 @@ def plot_time_compare(time, measured: dict, simulated: dict, channels, path, win
              "character, not the waveform (two unrelated signals give eq 6 RMSE about 1.4).",
              fontsize=7, color="0.3")
     fig.tight_layout(rect=(0, 0.03, 1, 1))
-    paths = [Path(p) for p in path] if isinstance(path, (list, tuple)) else [Path(path)]
-    for p in paths:       # one drawing, every format asked for
-        fig.savefig(p, dpi=150)
-    plt.close(fig)
-    return paths[0]
+    from eroad.figures import save_figure
+
+    return save_figure(fig, path, dpi=150)[0]
 
 
 def plot_amplitude_distributions(measured: dict, simulated: dict, channels, path, bins: int = 60,
@@ -193,7 +190,6 @@ def plot_amplitude_distributions(measured: dict, simulated: dict, channels, path
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from pathlib import Path
 
     fig, axes = plt.subplots(1, len(channels), figsize=(4.2 * len(channels), 3.4), squeeze=False)
     for ax, c in zip(axes[0], channels):
@@ -215,8 +211,6 @@ def plot_amplitude_distributions(measured: dict, simulated: dict, channels, path
              "simulated amplitude\ndistributions over the measured standard deviation (0: identical). "
              "Simulated: one random-phase road of the fitted spectra.", fontsize=7, color="0.3")
     fig.tight_layout(rect=(0, 0.07, 1, 1))
-    paths = [Path(p) for p in path] if isinstance(path, (list, tuple)) else [Path(path)]
-    for p in paths:       # one drawing, every format asked for
-        fig.savefig(p, dpi=150)
-    plt.close(fig)
-    return paths[0]
+    from eroad.figures import save_figure
+
+    return save_figure(fig, path, dpi=150)[0]

@@ -313,14 +313,10 @@ def plot_contact(folder: str | Path, path: str | Path) -> list[Path]:
 
 def save_png_pdf(fig, path, dpi: int = 120) -> list:
     """Write ``fig`` as PNG at ``path`` and as PDF beside it, close it; the two paths."""
-    import matplotlib.pyplot as plt
+    from eroad.figures import save_figure
 
     p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(p, dpi=dpi)
-    fig.savefig(p.with_suffix(".pdf"))
-    plt.close(fig)
-    return [p, p.with_suffix(".pdf")]
+    return save_figure(fig, [p, p.with_suffix(".pdf")], dpi=dpi)
 
 
 def run_pantograph_contact(road_path: str | Path | None, out_root: str | Path = "results", *,
