@@ -1052,8 +1052,7 @@ class Context:
 def inverse_road(sig: Signals, vehicle, workers: int = 2):
     """The full inverse fit (``inverse.pipeline.invert`` with ``inverse.truck``) of the whole
     record: boundaries [s] and per-segment (Gq_n0, w, nmin, nmax)."""
-    from concurrent.futures import ProcessPoolExecutor
-
+    from eroad.threads import process_pool
     from inverse.pipeline import InversionConfig, invert
     from inverse.sensitivity import FitConfig
     from inverse.truck import TruckSimulator, truck_predict_rms
@@ -1065,7 +1064,7 @@ def inverse_road(sig: Signals, vehicle, workers: int = 2):
 
     cfg = InversionConfig(fit=FitConfig(n_workers=1))
     if workers > 1:
-        with ProcessPoolExecutor(workers) as pool:
+        with process_pool(workers) as pool:
             inv = invert(sig.time, chans, sig.speed, make, predict_rms=truck_predict_rms(str(vehicle)),
                          config=cfg, map_fn=pool.map)
     else:
@@ -1348,13 +1347,12 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     dict
         The summary written to ``out/summary.json``.
     """
-    from concurrent.futures import ProcessPoolExecutor
-
     from diagnosis.compare import distribution_shape, front_rear, transmissibility
     from diagnosis.report import write_report
     from diagnosis.verdict import SIGNATURE_METHOD, search_ranges
     from diagnosis.which import combine_folds, rank_effects
     from diagnosis.where import localize
+    from eroad.threads import process_pool
     from vehicles.params import load_vehicle
 
     wall0 = _time.perf_counter()
@@ -1410,7 +1408,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
              f"{len(held)} held-out windows ({workers} worker(s)"
              + (", two folds: then the roles swapped)" if folds == 2 else ")"))
     splits = [(calib, held, seed)] + ([(held, calib, seed + 1)] if folds == 2 else [])
-    ex = ProcessPoolExecutor(workers) if workers and workers > 1 else None
+    ex = process_pool(workers) if workers and workers > 1 else None
     try:
         rankings = [rank_effects(cands, fit, simulate, c, h, seed=sd, executor=ex,
                                  progress=progress, delay=delay_term(model),

@@ -312,6 +312,15 @@ class LinearFeatures:
             raise RuntimeError("linear features: expected the dy = 0 group first")
         self._gcache = {}
 
+    def __getstate__(self):
+        # for a process pool (the road-model choice runs a segment per worker): the
+        # linear model is needed only to build the arrays above (and may hold Exudyn
+        # objects, which do not pickle); the coherence cache is rebuilt on demand
+        state = dict(self.__dict__)
+        state["lm"] = None
+        state["_gcache"] = {}
+        return state
+
     @property
     def n_segments(self) -> int:
         return len(self._win)

@@ -238,10 +238,16 @@ def linear_features_for(inv, simulate, speed):
                           lam=getattr(simulate, "lam", 1.0))
 
 
-def select_road_models(inv, simulate, speed, mode: str = "auto", bounds: ParamBounds | None = None) -> list:
+def _select_task(args) -> dict:
+    return select_segment(*args)
+
+
+def select_road_models(inv, simulate, speed, mode: str = "auto", bounds: ParamBounds | None = None,
+                       map_fn=map) -> list:
     """Per segment of an :class:`inverse.pipeline.Inversion`, the road-model fields
     (:func:`select_segment`); ``mode`` 'one' reports one slope everywhere without
-    fitting a second."""
+    fitting a second.  ``map_fn`` (e.g. a process pool's ``map``) runs the segments in
+    parallel, the longest window first; the fields are the same either way."""
     if mode not in ROAD_MODEL_MODES:
         raise EroadInputError(f"--road-model must be one of {', '.join(ROAD_MODEL_MODES)}, got {mode!r}")
     P = np.asarray(inv.fit.params, dtype=float)
@@ -249,7 +255,12 @@ def select_road_models(inv, simulate, speed, mode: str = "auto", bounds: ParamBo
         return [one_slope_fields(P[k, 1], note="--road-model one") for k in range(P.shape[0])]
     lin = linear_features_for(inv, simulate, speed)
     bounds = bounds or inv.config.bounds
-    return [select_segment(lin, inv.features, k, P[k], bounds) for k in range(P.shape[0])]
+    order = sorted(range(P.shape[0]), key=lambda k: -inv.features.windows[k].y.size)
+    fields = list(map_fn(_select_task, [(lin, inv.features, k, P[k], bounds) for k in order]))
+    out = [None] * P.shape[0]
+    for k, f in zip(order, fields):
+        out[k] = f
+    return out
 
 
 def add_road_models(segments: list, fields: list) -> list:

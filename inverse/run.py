@@ -238,8 +238,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     pool = None
     map_fn = map
     if workers > 1:
-        from concurrent.futures import ProcessPoolExecutor
-        pool = ProcessPoolExecutor(workers, initializer=_warm_worker)
+        from eroad.threads import process_pool
+        pool = process_pool(workers, initializer=_warm_worker)
         pool.submit(int)       # start the workers now: their imports overlap the segmentation
         map_fn = pool.map
     timing = {}
@@ -303,7 +303,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         t = _time.perf_counter()
         segs = inv.segments()
         from inverse.road_model import add_road_models, road_params, select_road_models
-        add_road_models(segs, select_road_models(inv, sim, speed, road_model))
+        add_road_models(segs, select_road_models(inv, sim, speed, road_model, map_fn=map_fn))
         road_p = road_params(params, segs)
         timing["road_model_s"] = _time.perf_counter() - t
         sel_thread = None

@@ -588,8 +588,8 @@ def fit_segments(simulate, features: FeatureSet, params0, *, seed: int = 0,
     pool = None
     if map_fn is None:
         if config.n_workers > 1:
-            from concurrent.futures import ProcessPoolExecutor
-            pool = ProcessPoolExecutor(config.n_workers)
+            from eroad.threads import process_pool
+            pool = process_pool(config.n_workers)
             map_fn = pool.map
         else:
             map_fn = map

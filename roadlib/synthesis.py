@@ -403,7 +403,12 @@ def harmonic_field(params: SpectralParams, length: float, width: float = 0.0,
     # indexing it, in a quarter of the time for the usual band)
     rng.bit_generator.advance(int(k[0]) * m.size)
     phi = rng.uniform(0.0, 2.0 * np.pi, size=(int(k[-1] - k[0]) + 1, m.size))[k - k[0]]
-    coef = amp * np.exp(1j * phi)
+    # amp e^(i phi) written as its real and imaginary parts: bit-identical to
+    # ``amp * np.exp(1j * phi)`` (e^0 = 1 exactly) and a third faster, the costliest line of
+    # a road (the inversion's realisation selection draws one road per candidate)
+    coef = np.empty(phi.shape, dtype=complex)
+    np.multiply(amp, np.cos(phi), out=coef.real)
+    np.multiply(amp, np.sin(phi), out=coef.imag)
     return HarmonicField(n=n, k=k, m=m, coef=coef, dx=dx, n_fft=int(n_fft))
 
 
