@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from functools import lru_cache
 
 import numpy as np
 import scipy.fft
@@ -327,6 +328,44 @@ def band_weights(n, dn: float, nmin: float, nmax: float) -> np.ndarray:
     return np.clip((hi - lo) / dn, 0.0, 1.0)
 
 
+@lru_cache(maxsize=16)
+def _amplitudes(params: SpectralParams, n_fft: int, width: float, lateral: bool):
+    """The harmonics' bins ``k``, frequencies ``n`` [cycles/m], lateral wavenumbers ``m``
+    [cycles/m] and amplitudes (n.size, m.size) [m] of a field: everything but the phases.
+    Cached (read-only arrays): the inversion and the diagnosis draw many seeds of one
+    spectrum (the realisation selection, one road per candidate)."""
+    dx = params.dx
+    dn = 1.0 / (n_fft * dx)
+    n_bins = n_fft // 2 + 1
+    weight = band_weights(np.arange(n_bins) * dn, dn, params.nmin, params.nmax)
+    weight[0] = 0.0
+    if params.nmax - params.nmin < dn or not np.any(weight > 0):
+        raise EroadInputError(
+            f"no harmonic between nmin = {params.nmin} and nmax = {params.nmax} cycles/m "
+            f"at frequency step {dn:.3g} cycles/m; widen the band or lengthen the road")
+    k = np.flatnonzero(weight > 0)
+    n = k * dn
+    gd = road_psd(n, params.Gq_n0, params.w, params.w2, params.n_break)
+    if lateral:
+        period_y = LATERAL_PERIOD_FACTOR * (width + params.dy)
+        dm = 1.0 / period_y
+        l_max = int(math.ceil(1.0 / (2.0 * params.dy) / dm)) - 1     # |m_l| < 1/(2 dy)
+        m = np.arange(-l_max, l_max + 1) * dm
+        p = lateral_density(m[None, :], n[:, None], params.w, params.lam)
+        if params.two_slope:   # local waviness above the break
+            hi = n > params.n_break
+            if np.any(hi):
+                p[hi] = lateral_density(m[None, :], n[hi, None], params.w2, params.lam)
+        q = p / p.sum(axis=1, keepdims=True)
+    else:
+        m = np.zeros(1)
+        q = np.ones((n.size, 1))
+    amp = np.sqrt(2.0 * gd[:, None] * dn * weight[k][:, None] * q)
+    for a in (k, n, m, amp):
+        a.setflags(write=False)
+    return k, n, m, amp
+
+
 def harmonic_field(params: SpectralParams, length: float, width: float = 0.0,
                    seed=0, n_fft: int | None = None, lateral: bool | None = None) -> HarmonicField:
     """Draw the harmonics of a road of the given size.
@@ -366,34 +405,7 @@ def harmonic_field(params: SpectralParams, length: float, width: float = 0.0,
         n_fft = scipy.fft.next_fast_len(need, real=True)
     elif n_fft < nx:
         raise EroadInputError(f"n_fft = {n_fft} is shorter than the road ({nx} samples)")
-    dn = 1.0 / (n_fft * dx)
-    n_bins = n_fft // 2 + 1
-    weight = band_weights(np.arange(n_bins) * dn, dn, params.nmin, params.nmax)
-    weight[0] = 0.0
-    if params.nmax - params.nmin < dn or not np.any(weight > 0):
-        raise EroadInputError(
-            f"no harmonic between nmin = {params.nmin} and nmax = {params.nmax} cycles/m "
-            f"at frequency step {dn:.3g} cycles/m; widen the band or lengthen the road")
-    k = np.flatnonzero(weight > 0)
-    n = k * dn
-    gd = road_psd(n, params.Gq_n0, params.w, params.w2, params.n_break)
-    if lateral is None:
-        lateral = width > 0
-    if lateral:
-        period_y = LATERAL_PERIOD_FACTOR * (width + params.dy)
-        dm = 1.0 / period_y
-        l_max = int(math.ceil(1.0 / (2.0 * params.dy) / dm)) - 1     # |m_l| < 1/(2 dy)
-        m = np.arange(-l_max, l_max + 1) * dm
-        p = lateral_density(m[None, :], n[:, None], params.w, params.lam)
-        if params.two_slope:   # local waviness above the break
-            hi = n > params.n_break
-            if np.any(hi):
-                p[hi] = lateral_density(m[None, :], n[hi, None], params.w2, params.lam)
-        q = p / p.sum(axis=1, keepdims=True)
-    else:
-        m = np.zeros(1)
-        q = np.ones((n.size, 1))
-    amp = np.sqrt(2.0 * gd[:, None] * dn * weight[k][:, None] * q)
+    k, n, m, amp = _amplitudes(params, int(n_fft), float(width), bool(width > 0 if lateral is None else lateral))
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     rng = np.random.default_rng(ss)
     # one phase per bin of the whole grid (k = 0 .. n_fft/2) and lateral harmonic,
