@@ -645,6 +645,27 @@ def _resolve_vehicle(folder: Path, ds: dict, probs: _Problems) -> str | Path | N
     return v
 
 
+def axle_positions(vehicle) -> dict[int, float] | None:
+    """Axle number (1 = front) -> position along x [m] of a resolved vehicle (a file path or
+    a built-in id), read from its TOML's ``[[axle]]`` tables without importing
+    :mod:`vehicles`; None when the file cannot be read (the vehicle's own loader reports
+    that where the vehicle is used)."""
+    path = Path(vehicle) if isinstance(vehicle, Path) else None
+    if path is None:
+        try:
+            spec = importlib.util.find_spec("vehicles")
+        except (ImportError, ValueError):
+            spec = None
+        for loc in (spec.submodule_search_locations or []) if spec is not None else []:
+            if Path(loc, "params", f"{vehicle}.toml").is_file():
+                path = Path(loc, "params", f"{vehicle}.toml")
+    try:
+        axles = tomllib.loads(path.read_text())["axle"]
+        return {i + 1: float(a["x"]) for i, a in enumerate(axles)}
+    except (AttributeError, OSError, KeyError, TypeError, ValueError, tomllib.TOMLDecodeError):
+        return None
+
+
 def _check_units(folder: Path, doc: dict, cols: list[str] | None, probs: _Problems) -> dict:
     """Optional [units] table: each entry must be the SI unit of its column."""
     metaf = folder / META_FILE
@@ -746,10 +767,22 @@ def inspect_drive(folder) -> tuple[list[str], Drive | None]:
         speed, source = np.full(t.size, speed_mps), "meta"
     for c in chans.columns:
         units.setdefault(c, QUANTITIES[parse_channel(c)[0]].unit)
-    from drives.plausibility import check_units as _physics
+    from drives.plausibility import check_signals, check_speed, check_units as _physics
 
     warnings = []
-    for f in _physics({c: chans[c].to_numpy(float) for c in chans.columns}, 1.0 / step):
+    arrays = {c: chans[c].to_numpy(float) for c in chans.columns}
+    findings = _physics(arrays, 1.0 / step)
+    findings += check_signals(arrays)
+    speed_findings = check_speed(arrays, speed, 1.0 / step, axle_positions(vehicle))
+    if source == "meta":   # the constant speed of meta.toml, not a column
+        for f in speed_findings:
+            msg = f"[dataset] speed_mps = {speed_mps:g}: {f.message}"
+            if f.fatal:
+                probs.add(folder / META_FILE, msg)
+            else:
+                warnings.append(f"{META_FILE}: {msg}")
+        speed_findings = []
+    for f in findings + speed_findings:
         if f.fatal:
             probs.add(csv, f.message, column=f.column)
         else:

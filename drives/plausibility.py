@@ -60,6 +60,37 @@ UNIT_ERRORS = {
 #: |log10| distance to an identified unit error within which it is named [-]
 UNIT_LOG10_TOL = 0.3
 
+#: band of the two-input fit of the body acceleration [Hz]: it must hold the body's bounce
+#: (1-3 Hz for trucks), where a_body is a fair share of s'' -- above 4 Hz the body term is a
+#: few per cent of the axle's, and a body channel in g hides in the ratio's tolerance
+FIT_BAND_HZ = (1.0, 15.0)
+#: share of the band-passed s'' the two-input fit must explain before its body factor is
+#: trusted [-]. Measured 0.93-0.998 per side-averaged axle on drives of the independently
+#: written truck (drives/independent_truck.py); a mislabelled channel falls far below
+MIN_FIT_R2 = 0.5
+#: body factors accepted as SI for an axle with both sides [-]: 0.2-1.5. Measured per
+#: side-averaged axle on 20 s drives: 0.97-1.05 on the independently written truck (with and
+#: without leaf friction), 0.96-1.01 on our null truck, 0.75-1.07 on our truck with a
+#: flexible frame (`random`; the frame bends between the spring seat and the body
+#: accelerometer), and 0.50-0.56 above axle 2 on drives where the body barely moves there:
+#: the body sensor's noise biases a least-squares factor low (errors in variables: beta times
+#: var(signal) / (var(signal) + var(noise))), so below 1 the bound is loose; g is 9.81, mm/s^2
+#: 0.001, both far outside (benchmarks/bench_units.py, results/units_blind/)
+BODY_RANGE_PAIR = (0.2, 1.5)
+#: the same for a single side [-]: the body above one axle end rolls and twists with the
+#: frame, measured 0.49-1.63 on the same drives
+BODY_RANGE = (0.2, 2.5)
+#: standard errors by which beta must leave the SI range before it is reported [-]
+BETA_SIGMAS = 3.0
+#: records shorter than this get no body fit [s]: four periods of the band's lower edge
+MIN_FIT_DURATION_S = 4.0 / FIT_BAND_HZ[0]
+#: the body-acceleration unit errors the two-input fit identifies: log10 factor -> meaning
+BODY_UNIT_ERRORS = {
+    math.log10(G): "body accelerations in g (expected m/s^2: multiply by 9.80665)",
+    math.log10(1.0 / 1000.0): "body accelerations in mm/s^2 (expected m/s^2: divide by 1000)",
+}
+
+
 @dataclass(frozen=True)
 class Finding:
     """One plausibility finding.
@@ -119,6 +150,96 @@ def kinematic_ratio(susp: np.ndarray, axle_acc: np.ndarray, body_acc: np.ndarray
     return ra / rs, corr
 
 
+def kinematic_fit(susp: np.ndarray, axle_acc: np.ndarray, body_acc: np.ndarray,
+                  fs: float) -> tuple[float, float, float, float]:
+    """Least-squares factors of ``s'' = alpha a_axle - beta a_body`` in ``FIT_BAND_HZ``.
+
+    The ratio of :func:`kinematic_ratio` sees the two accelerations only as their
+    difference, which above the body's bounce is almost all axle: a body channel in g
+    moves it by a few per cent. Fitting the two factors apart, over a band that holds the
+    body's bounce, weighs each channel on its own: ``alpha = beta = 1`` in SI units
+    whatever the vehicle, road or model (the identity is kinematic), ``beta = 9.81`` for a
+    body channel in g, ``beta = -1`` for one mounted upside down.
+
+    Returns
+    -------
+    alpha, beta : float
+        The factors [-] (NaN when a band-passed input is zero).
+    r2 : float
+        Share of the band-passed s'' variance the fit explains [-].
+    se_beta : float
+        Standard error of beta [-], from the residual over 2 x bandwidth x duration
+        independent samples (a body that barely moves above this axle gives a large one).
+    """
+    x = np.asarray(susp, float)
+    s2 = np.empty_like(x)
+    s2[1:-1] = (x[2:] - 2.0 * x[1:-1] + x[:-2]) * fs * fs
+    s2[0], s2[-1] = s2[1], s2[-2]
+    hi = min(FIT_BAND_HZ[1], 0.4 * fs)
+    sos = butter(4, [FIT_BAND_HZ[0], hi], btype="band", fs=fs, output="sos")
+    y = sosfiltfilt(sos, s2 - np.mean(s2))
+    a = sosfiltfilt(sos, np.asarray(axle_acc, float) - np.mean(axle_acc))
+    b = sosfiltfilt(sos, np.asarray(body_acc, float) - np.mean(body_acc))
+    if not (np.std(a) > 0 and np.std(b) > 0 and np.std(y) > 0):
+        return float("nan"), float("nan"), 0.0, float("inf")
+    design = np.c_[a, -b]
+    coef, *_ = np.linalg.lstsq(design, y, rcond=None)
+    r = y - design @ coef
+    # standard error of beta: band-passed samples are correlated, so the residual variance
+    # counts n_eff = 2 x bandwidth x duration independent samples, not every sample
+    n_eff = max(2.0 * (hi - FIT_BAND_HZ[0]) * x.size / fs, 3.0)
+    cov = np.var(r) * np.linalg.inv(design.T @ design) * (x.size / n_eff)
+    return (float(coef[0]), float(coef[1]), float(1.0 - np.var(r) / np.var(y)),
+            float(np.sqrt(max(cov[1, 1], 0.0))))
+
+
+def _body_finding(st: str, susp, axle, body, fs: float) -> Finding | None:
+    """The body channel's own unit check at station ``st`` (None: it passes, or the fit
+    cannot tell)."""
+    if len(susp) / fs < MIN_FIT_DURATION_S:
+        return None
+    _, beta, r2, se = kinematic_fit(susp, axle, body, fs)
+    if not np.isfinite(beta) or r2 < MIN_FIT_R2:
+        return None
+    # what the data cannot tell apart from SI is not reported: beta must leave the SI range
+    # by more than BETA_SIGMAS standard errors (a short record, a body at rest above the axle)
+    lo, hi = BODY_RANGE if st[-1] in "LR" else BODY_RANGE_PAIR
+    margin = BETA_SIGMAS * se
+    col = f"body_acc_{st}" if st[-1] in "LR" else f"body_acc_{st}L/R"
+    text = (f"fit of s'' = alpha a_axle - beta a_body at station {st} in {FIT_BAND_HZ[0]:g}-"
+            f"{FIT_BAND_HZ[1]:g} Hz (R^2 {r2:.2f}): beta = {beta:.3g} +- {se:.2g} (1 in SI units)")
+    if beta >= 0.0:
+        if lo - margin <= beta <= hi + margin:
+            return None
+        lb = math.log10(max(beta, 1e-12))
+        best = min(BODY_UNIT_ERRORS, key=lambda v: abs(v - lb))
+        if abs(best - lb) <= UNIT_LOG10_TOL:
+            return Finding(col, f"{text}: {BODY_UNIT_ERRORS[best]}", True)
+        return Finding(col, f"{text}: a scale error in the body accelerometer?", False)
+    if -beta <= margin:
+        return None                                   # not even the sign is determined
+    if lo - margin <= -beta <= hi + margin:
+        return Finding(col, f"{text}: the body acceleration's sign is flipped (positive up "
+                       f"expected; a sensor mounted upside down?)", False)
+    return Finding(col, f"{text}: does the body channel belong to this station?", False)
+
+
+def _which_in_g(err: float, susp, axle, body, fs: float) -> str:
+    """The unit error ``UNIT_ERRORS[err]``, narrowed to the axle or the body channel when the
+    ratio says g and the two-input fit (:func:`kinematic_fit`) finds only one of them in g."""
+    text = UNIT_ERRORS[err]
+    if body is None or err != math.log10(1.0 / G):
+        return text
+    alpha, beta, r2, _ = kinematic_fit(susp, axle, body, fs)
+    if r2 < MIN_FIT_R2 or not (alpha > 0 and beta > 0):
+        return text
+    in_g = [abs(math.log10(f) - math.log10(G)) <= UNIT_LOG10_TOL for f in (alpha, beta)]
+    if in_g == [True, False]:
+        return (f"axle accelerations in g, body accelerations in m/s^2 (fit factors {alpha:.3g} "
+                f"and {beta:.3g}; multiply the axle channels by 9.80665)")
+    return text
+
+
 def check_units(channels: dict, fs: float) -> list[Finding]:
     """Every plausibility finding of a drive's channels.
 
@@ -161,11 +282,15 @@ def check_units(channels: dict, fs: float) -> list[Finding]:
             continue
         lr = math.log10(ratio)
         if abs(lr) <= tol:
+            if body is not None:   # the ratio passes: the body channel on its own
+                found = _body_finding(st, susp, axle, body, fs)
+                if found is not None:
+                    out.append(found)
             continue
         best = min(UNIT_ERRORS, key=lambda v: abs(v - lr))
         text = f"rms({pair}) / rms(d^2/dt^2 suspension displacement) = {ratio:.3g} {where} (1 in SI units)"
         if abs(best - lr) <= UNIT_LOG10_TOL:
-            out.append(Finding(sname, f"{text}: {UNIT_ERRORS[best]}", True))
+            out.append(Finding(sname, f"{text}: {_which_in_g(best, susp, axle, body, fs)}", True))
         else:
             out.append(Finding(sname, f"{text}: a unit or scale error in one of them?", False))
     return out
@@ -202,4 +327,207 @@ def _stations(channels: dict) -> dict:
             s = sides[0]
             out[f"{a}{s}"] = (channels[f"susp_disp_{a}{s}"], channels[f"axle_acc_{a}{s}"],
                               channels.get(f"body_acc_{a}{s}"))
+    return out
+
+
+# --------------------------------------------------------------------------- speed
+# The speed channel sets the distance scale of everything that follows (a spatial frequency
+# is a temporal one divided by the speed): a speed in km/h labelled m/s moves every road
+# spectrum by a factor 3.6 in wavenumber and the road class by several classes, while every
+# value stays inside a range check. Physics again tells: the axles of one side run over the
+# same track one behind the other, so their signals are copies of each other shifted by the
+# axle spacing in DISTANCE travelled, whatever the speed profile, vehicle model or road. The
+# distance comes from integrating the speed channel; a speed off by a factor k moves the
+# correlation peak to k times the spacing the vehicle file gives.
+
+#: band of the axle signals correlated [Hz]: the road's input through the tyres (the wheel
+#: hop at 8-15 Hz included), above the body's bounce that couples the axles at zero lag
+DELAY_BAND_HZ = (1.0, 20.0)
+#: grid of the distance-domain resampling [m]
+DELAY_GRID_M = 0.05
+#: lags searched, as multiples of the axle spacing [-]: 0.2-5 holds km/h (3.6), mph (2.24)
+#: and their inverses, and leaves out the zero-lag coupling through the frame
+DELAY_SCALE_RANGE = (0.2, 5.0)
+#: peak correlation below which an axle pair is not used [-]. Measured 0.6-0.99 on 20 s
+#: drives of the independently written truck (pairs across the tandem lower: its bogie
+#: and frame move the axles apart between the stations)
+MIN_DELAY_CORRELATION = 0.3
+#: pairs shorter than this are not used [m]: the peak must be resolved on the grid
+MIN_PAIR_SPACING_M = 1.0
+#: distance a record must cover, in axle spacings [-]
+MIN_SPACINGS_COVERED = 20.0
+#: |log10 k| accepted as a correct speed [-]: factor 1.1 (measured 0.99-1.00 on the
+#: independent truck's drives; the grid step is 1-4 % of a spacing)
+SPEED_LOG10_TOL = math.log10(1.1)
+#: a consistent k beyond this factor is refused even when no unit explains it [-]: the
+#: distance scale, and with it every wavelength and the road class, would be wrong by more
+#: than a factor 2 (a constant meta speed_mps for a drive whose speed varied, a wrong vehicle)
+SPEED_FATAL_FACTOR = 2.0
+#: the speed unit errors the delay identifies: k -> meaning
+SPEED_UNIT_ERRORS = {
+    3.6: "speed in km/h (expected m/s: divide by 3.6)",
+    1.0 / 3.6: "speed 3.6x too small (converted from km/h twice, or m/s read as km/h?)",
+    2.2369362921: "speed in mph (expected m/s: multiply by 0.44704)",
+    1.0 / 2.2369362921: "speed 2.24x too small (converted from mph twice?)",
+}
+#: relative distance to a named speed error within which it is named [-]
+SPEED_UNIT_TOL = 0.1
+#: a speed above this is not a heavy vehicle's [m/s]: 120 km/h, above the 90 km/h limiter of
+#: EU heavy goods vehicles (Directive 92/6/EEC as amended by 2002/85/EC) and the 65-80 mph
+#: of US truck speed limits, with margin
+HEAVY_VEHICLE_MAX_SPEED = 120.0 / 3.6
+
+
+def _along_distance(x: np.ndarray, s: np.ndarray, grid: np.ndarray, fs: float) -> np.ndarray:
+    hi = min(DELAY_BAND_HZ[1], 0.4 * fs)
+    sos = butter(4, [DELAY_BAND_HZ[0], hi], btype="band", fs=fs, output="sos")
+    return np.interp(grid, s, sosfiltfilt(sos, np.asarray(x, float) - np.mean(x)))
+
+
+def delay_scale(a: np.ndarray, b: np.ndarray, spacing: float, s: np.ndarray,
+                fs: float) -> tuple[float, float]:
+    """Distance scale of the speed from one axle pair of one side.
+
+    Parameters
+    ----------
+    a, b : (N,) arrays
+        The front and the rear axle's signal (acceleration or suspension displacement).
+    spacing : float
+        Their spacing from the vehicle file [m].
+    s : (N,) array
+        Distance travelled, the integral of the speed channel [m], non-decreasing.
+    fs : float
+        Sample rate [Hz].
+
+    Returns
+    -------
+    k : float
+        Lag of the correlation peak over ``spacing`` [-]: 1 for a right speed, 3.6 for km/h
+        labelled m/s (NaN when the record is too short).
+    corr : float
+        The peak's correlation coefficient [-].
+    """
+    keep = np.concatenate([[True], np.diff(s) > 0])   # standstill: one sample per position
+    s, a, b = s[keep], np.asarray(a, float)[keep], np.asarray(b, float)[keep]
+    if s[-1] - s[0] < MIN_SPACINGS_COVERED * spacing * DELAY_SCALE_RANGE[1] / 5.0:
+        return float("nan"), 0.0
+    grid = np.arange(s[0], s[-1], min(DELAY_GRID_M, spacing / 40.0))
+    fa, fb = _along_distance(a, s, grid, fs), _along_distance(b, s, grid, fs)
+    step = grid[1] - grid[0]
+    lags = np.arange(int(DELAY_SCALE_RANGE[0] * spacing / step),
+                     min(int(DELAY_SCALE_RANGE[1] * spacing / step), grid.size // 2) + 1)
+    if lags.size < 3:
+        return float("nan"), 0.0
+    n = grid.size
+    nfft = 1 << int(np.ceil(np.log2(2 * n)))
+    xc = np.fft.irfft(np.conj(np.fft.rfft(fa, nfft)) * np.fft.rfft(fb, nfft), nfft)[lags]
+    # the rear axle sees at s + L what the front saw at s: correlate a(s) with b(s + L)
+    ca = np.cumsum(fa ** 2)
+    cb = np.cumsum(fb[::-1] ** 2)[::-1]
+    norm = np.sqrt(ca[n - 1 - lags] * cb[lags])
+    c = xc / np.where(norm > 0, norm, np.inf)
+    i = int(np.argmax(c))
+    return float(lags[i] * step / spacing), float(c[i])
+
+
+def check_speed(channels: dict, speed: np.ndarray, fs: float,
+                axle_x: dict | None = None) -> list[Finding]:
+    """Speed plausibility: the axle-to-axle delay against the vehicle's axle spacing, and
+    the speed's level against a heavy vehicle's.
+
+    Parameters
+    ----------
+    channels : dict
+        Channel name -> (N,) array, contract names.
+    speed : (N,) array
+        The drive's speed [m/s as recorded].
+    fs : float
+        Sample rate [Hz].
+    axle_x : dict, optional
+        Axle number (1 = front) -> its position along x [m] from the vehicle file; without
+        it only the level is checked.
+
+    Returns
+    -------
+    list of Finding
+        On the column ``speed``. Fatal only for a named unit error found by the delay on at
+        least two axle pairs that agree.
+    """
+    speed = np.asarray(speed, float)
+    out: list[Finding] = []
+    s = np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1])) / fs])
+    pairs = []
+    for side in "LR":
+        for q in ("axle_acc", "susp_disp"):
+            have = sorted(a for a in (axle_x or {}) if f"{q}_{a}{side}" in channels)
+            if len(have) >= 2:
+                break
+        for i, a in enumerate(have):
+            for b in have[i + 1:]:
+                spacing = abs(axle_x[a] - axle_x[b])
+                if spacing < MIN_PAIR_SPACING_M:
+                    continue
+                k, c = delay_scale(channels[f"{q}_{a}{side}"], channels[f"{q}_{b}{side}"],
+                                   spacing, s, fs)
+                if np.isfinite(k) and c >= MIN_DELAY_CORRELATION:
+                    pairs.append((k, c, f"{a}{side}-{b}{side}"))
+    if len(pairs) >= 2:
+        ks = np.array([p[0] for p in pairs])
+        k = float(np.median(ks))
+        agree = int(np.sum(np.abs(np.log(ks / k)) <= math.log(1.0 + SPEED_UNIT_TOL)))
+        if abs(math.log10(k)) > SPEED_LOG10_TOL:
+            text = (f"the axles' signals repeat {k:.3g}x farther apart than the vehicle file's "
+                    f"axle spacing, in distance integrated from this speed ({agree} of "
+                    f"{len(pairs)} axle pairs agree)")
+            best = min(SPEED_UNIT_ERRORS, key=lambda v: abs(math.log(k / v)))
+            consistent = agree >= 2 and 2 * agree >= len(pairs)
+            if abs(math.log(k / best)) <= math.log(1.0 + SPEED_UNIT_TOL) and consistent:
+                out.append(Finding("speed", f"{text}: {SPEED_UNIT_ERRORS[best]}", True))
+            elif abs(math.log(k)) > math.log(SPEED_FATAL_FACTOR) and consistent:
+                out.append(Finding("speed", f"{text}: the speed is off by that factor, or the "
+                                   f"vehicle file's axle positions are not this vehicle's; either "
+                                   f"way no road could be identified from it", True))
+            else:
+                out.append(Finding("speed", f"{text}: the speed is off by that factor, or the "
+                                   f"vehicle file's axle positions are not this vehicle's", False))
+        return out
+    vmax = float(np.max(speed)) if speed.size else 0.0
+    if vmax > HEAVY_VEHICLE_MAX_SPEED:
+        out.append(Finding("speed", f"up to {vmax:.4g} m/s ({vmax * 3.6:.4g} km/h), above what a "
+                           f"heavy vehicle drives ({HEAVY_VEHICLE_MAX_SPEED * 3.6:.0f} km/h): in "
+                           f"km/h? ({vmax / 3.6:.3g} m/s if so; no two axles of one side to "
+                           f"check it on)", False))
+    return out
+
+
+# --------------------------------------------------------------------------- dead and clipped
+#: share of the samples at the record's extreme value (either end) from which a channel is
+#: called clipped [-]; with at least CLIP_MIN_SAMPLES of them. A continuous signal with
+#: noise takes its extreme value once
+CLIP_SHARE = 0.002
+CLIP_MIN_SAMPLES = 5
+
+
+def check_signals(channels: dict) -> list[Finding]:
+    """Channels that hold no measurement: constant over the record (a dead sensor, an
+    unconnected logger input), or clipped (many samples at exactly the extreme value: the
+    sensor's or the logger's range). Warnings: the column may not be one a command uses."""
+    out: list[Finding] = []
+    for name, x in channels.items():
+        x = np.asarray(x, float)
+        if x.size < 2:
+            continue
+        lo, hi = float(np.min(x)), float(np.max(x))
+        if hi == lo:
+            out.append(Finding(name, f"constant {lo:g} over the whole record: a dead sensor or an "
+                               f"empty logger channel; a command that uses it will see no motion", False))
+            continue
+        tol = 1e-9 * (hi - lo)
+        n = x.size
+        for v, end in ((hi, "maximum"), (lo, "minimum")):
+            k = int(np.sum(np.abs(x - v) <= tol))
+            if k >= max(CLIP_MIN_SAMPLES, CLIP_SHARE * n):
+                out.append(Finding(name, f"{k} samples ({100.0 * k / n:.2g} %) sit at exactly the "
+                                   f"{end} {v:g}: clipped at the sensor's or logger's range? The "
+                                   f"spectrum above that level is lost", False))
     return out

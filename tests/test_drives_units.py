@@ -11,7 +11,8 @@ import pandas as pd
 import pytest
 
 from drives.format import read_drive, write_drive
-from drives.plausibility import G, check_units, kinematic_ratio
+from drives.plausibility import (G, check_signals, check_speed, check_units, delay_scale, kinematic_fit,
+                                   kinematic_ratio)
 from eroad.cli import main
 from eroad.errors import EroadInputError
 
@@ -155,3 +156,147 @@ def test_a_scale_error_of_two_is_a_warning_on_every_axle(truck_drive):
                         truck_drive.sample_rate_hz)
     assert sorted(f.column for f in found) == [f"susp_disp_{a}L/R" for a in "1234"]
     assert not any(f.fatal for f in found) and all("scale error" in f.message for f in found)
+
+
+# --------------------------------------------------------------------------- body channel on its own
+
+def test_body_channel_in_g_alone_is_refused_and_named():
+    """Body accelerations in g with the axle ones in m/s^2: the ratio of (a_axle - a_body) moves
+    by a few per cent only (above 4 Hz the body is a small part of it), so only the two-input fit
+    over 1-15 Hz sees it: beta = 9.81 (exact identity here) -> fatal on the body column."""
+    ch = _channels(station_frame(seed=6))
+    bad = {k: (v / G if k.startswith("body") else v) for k, v in ch.items()}
+    found = check_units(bad, FS)
+    assert found and all(f.fatal for f in found)
+    assert sorted(f.column for f in found) == ["body_acc_1L/R", "body_acc_3L/R"]
+    assert all("body accelerations in g" in f.message for f in found)
+
+
+def test_axle_channel_in_g_alone_is_named_as_the_axle():
+    ch = _channels(station_frame(seed=7))
+    bad = {k: (v / G if k.startswith("axle") else v) for k, v in ch.items()}
+    found = check_units(bad, FS)
+    assert len(found) == 2 and all(f.fatal and "axle accelerations in g, body accelerations in m/s^2"
+                                   in f.message for f in found), [f.message for f in found]
+
+
+def test_body_sign_flip_is_a_warning():
+    ch = _channels(station_frame(seed=8, axles=(2,)))
+    ch["body_acc_2L"], ch["body_acc_2R"] = -ch["body_acc_2L"], -ch["body_acc_2R"]
+    found = check_units(ch, FS)
+    assert len(found) == 1 and not found[0].fatal and "sign is flipped" in found[0].message
+
+
+def test_kinematic_fit_factors_are_one_in_si():
+    """alpha = beta = 1 within 5 % and R^2 > 0.98: the compact second difference reads
+    (sin(pi f/fs)/(pi f/fs))^2 = 0.967 of s'' at 20 Hz, the top of the axle's 2-20 Hz motion here,
+    so alpha comes out 0.961 and the frequency-dependent rest leaks into beta (0.974, R^2 0.985);
+    the unit gates are factors 1.5 and 9.81 away."""
+    ch = _channels(station_frame(seed=9))
+    alpha, beta, r2, se = kinematic_fit(ch["susp_disp_1L"], ch["axle_acc_1L"], ch["body_acc_1L"], FS)
+    assert 0 < se < 0.05
+    assert alpha == pytest.approx(1.0, abs=0.05) and beta == pytest.approx(1.0, abs=0.05) and r2 > 0.98
+
+
+def test_exudyn_drive_body_in_g_is_refused_on_every_axle(truck_drive):
+    ch = {c: truck_drive.channels[c].to_numpy() for c in truck_drive.channel_names}
+    found = check_units({k: (v / G if k.startswith("body") else v) for k, v in ch.items()},
+                        truck_drive.sample_rate_hz)
+    assert sorted(f.column for f in found if f.fatal and "body accelerations in g" in f.message) \
+        == [f"body_acc_{a}L/R" for a in "1234"]
+
+
+# --------------------------------------------------------------------------- speed from the axle delay
+
+AXLE_X = {1: 0.0, 2: -1.8, 3: -5.0, 4: -6.35}   # the 8x4 truck's file
+
+
+def road_drive(seed=0, duration=30.0, vary=2.0):
+    """Axle signals as copies of one band-limited road profile z(s) under each axle (axle i at
+    x_i sees z(s + x_i)), with a speed that varies 8-12 m/s in closed form: the delay holds in
+    distance, not time. No vehicle model: the reference is kinematic."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(duration * FS)) / FS
+    v = 10.0 + vary * np.sin(0.3 * t)
+    s = 10.0 * t - (vary / 0.3) * (np.cos(0.3 * t) - 1.0)
+    n = rng.uniform(0.05, 2.0, 60)
+    ph = rng.uniform(0, 2 * np.pi, 60)
+    amp = 0.005 / n
+    ch = {}
+    for a, x in AXLE_X.items():
+        for side, off in (("L", 0.0), ("R", 1.0)):
+            ch[f"axle_acc_{a}{side}"] = (amp[:, None] * np.sin(2 * np.pi * n[:, None] * (s + x) + ph[:, None]
+                                                              + off * rng.uniform(0, 1, 60)[:, None])).sum(0)
+    return ch, v
+
+
+@pytest.mark.parametrize("factor, fatal, expect", [
+    (1.0, None, None),
+    (3.6, True, "speed in km/h"),
+    (1.0 / 3.6, True, "3.6x too small"),
+    (2.2369362921, True, "speed in mph"),
+    (1.25, False, "off by that factor"),
+    (2.8, True, "no road could be identified"),
+])
+def test_speed_scale_from_the_axle_delay(factor, fatal, expect):
+    """The correlation peak of two axles of a side sits at the axle spacing in distance
+    integrated from the speed: a speed off by k puts it at k spacings. Named unit errors and
+    any factor beyond 2 are fatal, a smaller one a warning, a right speed gives nothing (tolerance factor 1.1; the
+    grid step 0.045-0.05 m is 1-4 % of a spacing)."""
+    ch, v = road_drive()
+    found = check_speed(ch, v * factor, FS, AXLE_X)
+    if expect is None:
+        assert found == []
+        return
+    assert len(found) == 1 and found[0].fatal is fatal and expect in found[0].message, found
+    k, c = delay_scale(ch["axle_acc_1L"], ch["axle_acc_3L"], 5.0,
+                       np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1])) * factor / FS]), FS)
+    if factor > 0.5:   # the 5 m pair's lag at 1/3.6 is below the searched 0.2 spacings
+        assert k == pytest.approx(factor, rel=0.02) and c > 0.9
+
+
+def test_speed_level_without_two_axles_is_a_warning():
+    ch, v = road_drive()
+    one = {k: x for k, x in ch.items() if k.startswith("axle_acc_3")}
+    assert check_speed(one, v, FS, AXLE_X) == []
+    found = check_speed(one, v * 3.6, FS, AXLE_X)
+    assert len(found) == 1 and not found[0].fatal and "in km/h?" in found[0].message
+    assert check_speed(ch, v * 3.6, FS, None)[0].fatal is False   # no vehicle file: level only
+
+
+def test_independent_truck_drive_passes_and_its_kmh_speed_is_refused(tmp_path, capsys):
+    """A drive of the independently written truck (not our model) reads clean; the same drive
+    with its speed column in km/h is refused by the reader with one line and by `eroad data
+    check` with exit 2; a meta.toml speed 3.6x off (no speed column) is refused naming meta.toml."""
+    from drives.synth import synth_command
+    out = tmp_path / "second"
+    synth_command(scenario="second", seed=21, duration=10.0, out=out)
+    assert not any("speed" in w for w in read_drive(out).warnings)
+    df = pd.read_csv(out / "channels.csv")
+    df["speed"] = df["speed"] * 3.6
+    df.to_csv(out / "channels.csv", index=False, float_format="%.17g")
+    with pytest.raises(EroadInputError) as e:
+        read_drive(out)
+    msg = str(e.value)
+    assert "\n" not in msg and "column 'speed'" in msg and "speed in km/h" in msg
+    assert main(["data", "check", str(out)]) == 2
+    assert "speed in km/h" in capsys.readouterr().err
+    ch, v = road_drive(seed=3, duration=20.0, vary=0.0)
+    frame = pd.DataFrame({"time": np.arange(v.size) / FS, **ch})
+    path = write_drive(tmp_path / "meta-speed", frame, {"vehicle": "dump_truck_8x4", "speed_mps": 10.0})
+    assert read_drive(path).warnings == ()
+    (path / "meta.toml").write_text((path / "meta.toml").read_text().replace("speed_mps = 10.0", "speed_mps = 36.0"))
+    with pytest.raises(EroadInputError, match=r"meta.toml.*speed_mps = 36.*speed in km/h"):
+        read_drive(path)
+
+
+# --------------------------------------------------------------------------- dead and clipped channels
+
+def test_dead_and_clipped_channels_are_warnings(tmp_path):
+    df = station_frame(seed=10, axles=(3,))
+    df["axle_acc_3R"] = 0.0
+    df["body_acc_3L"] = df["body_acc_3L"].clip(-0.05, 0.05)
+    found = check_signals(_channels(df))
+    assert {f.column for f in found} == {"axle_acc_3R", "body_acc_3L"} and not any(f.fatal for f in found)
+    assert any("constant 0" in f.message for f in found) and any("clipped" in f.message for f in found)
+    assert check_signals(_channels(station_frame(seed=10, axles=(3,)))) == []
