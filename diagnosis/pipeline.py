@@ -595,6 +595,9 @@ def load_measured(dataset):
     names = [c for c in drive.channel_names if c.startswith(QUANTITIES)]
     if not names:
         raise EroadInputError(f"{dataset}: no susp_disp/axle_acc/body_acc channels to diagnose")
+    if not np.all(np.asarray(drive.speed) > 0.5):   # the road model runs in distance
+        from drives.cut import moving_hint
+        raise EroadInputError(moving_hint(drive.path, drive.time, drive.speed, "eroad diagnose"))
     t = np.asarray(drive.time, float)
     sig = Signals(t - t[0], {c: np.asarray(drive.channels[c], float) for c in names},
                   {c: drive.units.get(c, "") for c in names}, np.asarray(drive.speed, float),

@@ -39,6 +39,28 @@ def register(subparsers) -> None:
 
     register_import(dsub)
 
+    cut = dsub.add_parser(
+        "cut", help="a dataset cut to a time window, or to the stretches where the vehicle moves",
+        description="Write part of DATASET as new datasets: --window T0 T1 keeps that time span "
+        "(record time, as in the time column) in OUT; --moving writes each stretch with speed > "
+        "--min-speed of at least --min-duration as OUT/part01, OUT/part02, ... (what eroad invert "
+        "and eroad replica need from a drive with stops). The source is only read; nothing is "
+        "written unless every piece is valid.",
+        epilog="Example: eroad data cut my-drive --moving --out my-drive-moving")
+    cut.add_argument("dataset", metavar="DATASET", help="dataset folder")
+    cut.add_argument("--out", required=True, metavar="DIR", help="output folder (new or empty)")
+    cut.add_argument("--window", nargs=2, type=float, metavar=("T0", "T1"), default=None,
+                     help="keep T0 <= time <= T1 [s]")
+    cut.add_argument("--moving", action="store_true",
+                     help="one dataset per moving stretch (OUT/part01, ...)")
+    cut.add_argument("--min-speed", type=float, default=0.5, metavar="M_S",
+                     help="speed above which the vehicle is moving [m/s] (default 0.5, as eroad invert)")
+    cut.add_argument("--min-duration", type=float, default=3.0, metavar="S",
+                     help="shortest moving stretch kept [s] (default 3)")
+    cut.add_argument("--force", action="store_true", help="replace a non-empty --out")
+    cut.add_argument("--json", action="store_true", help="print the summary as JSON")
+    cut.set_defaults(func=cmd_cut)
+
     fig = dsub.add_parser(
         "figures", help="Figures 4 and 5: axle-3-left suspension displacement and spectra",
         description="Figure 4: third-axle left suspension displacement over the whole record "
@@ -122,6 +144,26 @@ def cmd_check(args) -> int:
         return 2
     s = {"valid": True, **drive.summary()}
     print(json.dumps(s, indent=2) if args.json else format_summary(s))
+    return 0
+
+
+def cmd_cut(args) -> int:
+    """``eroad data cut DATASET --out DIR [--window T0 T1] [--moving]``."""
+    from drives.cut import cut_dataset
+
+    s = cut_dataset(args.dataset, args.out, window=args.window, moving=args.moving,
+                    min_speed=args.min_speed, min_duration=args.min_duration, force=args.force)
+    if args.json:
+        print(json.dumps(s, indent=2))
+        return 0
+    for p in s["pieces"]:
+        print(f"wrote     {p['folder']}: t = {p['t_start_s']:.3f} .. {p['t_end_s']:.3f} s "
+              f"({p['duration_s']:.2f} s, speed >= {p['speed_min_mps']:.2f} m/s)")
+    for d in s["dropped"]:
+        print(f"dropped   t = {d['t_start_s']:.3f} .. {d['t_end_s']:.3f} s: moving, but shorter than "
+              f"{args.min_duration:g} s")
+    if args.moving:
+        print(f"left out  {s['slow_s']:.2f} s at or below {args.min_speed:g} m/s")
     return 0
 
 

@@ -944,7 +944,8 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
                               f"(susp_disp_*, axle_acc_*, body_acc_*); present: "
                               f"{', '.join(drive.channel_names) or 'none'}")
     if not np.all(np.asarray(drive.speed) > 0.5):
-        raise EroadInputError(f"{drive.path}: eroad replica needs a moving vehicle (speed > 0.5 m/s throughout)")
+        from drives.cut import moving_hint
+        raise EroadInputError(moving_hint(drive.path, drive.time, drive.speed, "eroad replica"))
     chans = {c: drive.channels[c].to_numpy(float) for c in names}
     lm, left_out, lin_notes = replica_linear_model(drive.vehicle, effects, chans, drive.sample_rate_hz)
     missing = [c for c in names if c not in lm.channel_names]

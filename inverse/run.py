@@ -212,7 +212,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     drive = read_drive(dataset)
     drive.require(["susp_disp_3L", "susp_disp_3R"], "eroad invert")
     if not np.all(np.asarray(drive.speed) > 0.5):
-        raise EroadInputError(f"{drive.path}: eroad invert needs a moving vehicle (speed > 0.5 m/s throughout)")
+        from drives.cut import moving_hint
+        raise EroadInputError(moving_hint(drive.path, drive.time, drive.speed, "eroad invert"))
     n_cand = int(candidates if candidates is not None else (6 if quick else 16))
     iters = int(max_iter if max_iter is not None else (3 if quick else 12))
     if n_cand < 0 or iters < 1:
