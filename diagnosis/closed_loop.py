@@ -121,7 +121,7 @@ def _start(out, force: bool) -> tuple[Path, Path]:
 
 
 def _diagnosis_summary(dataset, work: Path, diagnosis, copy: bool, workers: int, quick: bool, seed: int,
-                       progress) -> dict:
+                       progress, out: Path | None = None) -> dict:
     """The diagnosis of a closed loop: a given run folder's summary (copied to work/diagnose
     when ``copy``), or a fresh diagnosis written there."""
     if diagnosis is not None:
@@ -133,7 +133,13 @@ def _diagnosis_summary(dataset, work: Path, diagnosis, copy: bool, workers: int,
     from diagnosis.pipeline import diagnose
 
     progress("closed loop: diagnosing the nominal model's gap ...")
-    return diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed)
+    # the diagnosis's own lines go where the loop's go (none with --quiet); it writes into the
+    # loop's temporary folder, which becomes the run folder: name that one
+
+    def say(msg: str) -> None:
+        progress(str(msg).replace(str(work), str(out)) if out is not None else msg)
+    return diagnose(dataset, work / "diagnose", workers=workers, quick=quick, force=True, seed=seed,
+                    progress=say)
 
 
 def still_poor_message(fit_quality: dict, effects: dict) -> str:
@@ -194,7 +200,7 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
         raise EroadInputError("--effects auto and explicit --effect values cannot be combined")
     out, work = _start(out, force)
     try:
-        dsum = _diagnosis_summary(dataset, work, diagnosis, True, workers, quick, seed, progress)
+        dsum = _diagnosis_summary(dataset, work, diagnosis, True, workers, quick, seed, progress, out)
         effects, reason = effects_from_diagnosis(dsum)
         inversion["channels"], why = loop_channels(dsum.get("verdict"), inversion.get("channels"))
         reason = f"{reason}; {why}" if why else reason
@@ -262,7 +268,7 @@ def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick:
         raise EroadInputError("--effects auto and explicit effect values cannot be combined")
     out, work = _start(out, force)
     try:
-        dsum = _diagnosis_summary(dataset, work, diagnosis, copy_diagnosis, workers, quick, seed, progress)
+        dsum = _diagnosis_summary(dataset, work, diagnosis, copy_diagnosis, workers, quick, seed, progress, out)
         effects, reason = effects_from_diagnosis(dsum, action="reconstructed")
         progress(f"closed loop: {reason}")
         summary = run_replica(dataset, work / "replica", effects=effects, argv=argv, progress=progress, **replica)

@@ -1114,6 +1114,18 @@ def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fi
                    _time.perf_counter() - t)
 
 
+def front_rear_or_none(sig, sim, **kw):
+    """:func:`diagnosis.compare.front_rear`, or None where the record has no axle
+    acceleration of axles 1 and 3 on one side (a logger on one axle only): the report then
+    says the front-to-rear comparison was not made, and the ranking runs without its delay
+    term (:func:`delay_term`)."""
+    from diagnosis.compare import front_rear
+
+    if not any(f"axle_acc_1{s}" in sig.channels and f"axle_acc_3{s}" in sig.channels for s in "LR"):
+        return None
+    return front_rear(sig, sim, **kw)
+
+
 def delay_term(model: TruckModel):
     """The front-to-rear delay term of the gap (:class:`diagnosis.which.DelayTerm`): axle
     accelerations of the front axles (1, 2) against the rear axles (3, 4), both sides, with
@@ -1350,7 +1362,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     dict
         The summary written to ``out/summary.json``.
     """
-    from diagnosis.compare import distribution_shape, front_rear, transmissibility
+    from diagnosis.compare import distribution_shape, transmissibility
     from diagnosis.report import write_report
     from diagnosis.verdict import SIGNATURE_METHOD, search_ranges
     from diagnosis.which import combine_folds, rank_effects
@@ -1391,7 +1403,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     wheelbase = float(vp.axles[0].x - vp.axles[2].x) if len(vp.axles) >= 3 else None
     tr = transmissibility(sig, sim)
     tr2 = two_input_or_none(sig, sim)
-    fr = front_rear(sig, sim, wheelbase=wheelbase)
+    fr = front_rear_or_none(sig, sim, wheelbase=wheelbase)
     sh = distribution_shape(sig, sim)
     timing["localization_s"] = _time.perf_counter() - t
 

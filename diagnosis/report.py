@@ -515,6 +515,11 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                         else "no flagged band"))
         L.append("")
     FR = summary.get("front_rear")
+    if not FR and summary.get("transmissibility"):
+        L.append("**Front-to-rear delay**: not computed -- the record has no axle acceleration of "
+                 "axles 1 and 3 on one side, so the speed scale is not checked and `speed_scale` "
+                 "is ranked on the gap alone. The verdict's rules were set on drives with every "
+                 "axle's channels (docs/diagnosis.md); with fewer they rest on less.\n")
     if FR:
         L.append("**Front-to-rear delay** (GCC-SCOT of the lag in recorded distance, shown as a "
                  "delay at the mean recorded speed; measured/simulated ratio with 95 % interval "

@@ -65,7 +65,8 @@ no constraint; best for linearisation).  Degrees of freedom: 6 per body.
 from __future__ import annotations
 
 import contextlib
-import io
+import sys
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -503,17 +504,55 @@ class VehicleModel:
         return np.array(out)
 
 
+class _QuietStdout:
+    """Stand-in for ``sys.stdout`` while some thread is in :func:`_quiet`: it drops what the
+    quiet threads write and passes every other thread's writes to the stream it replaced."""
+
+    def __init__(self, real):
+        self.real = real
+
+    def write(self, text):
+        return len(text) if getattr(_QUIET_TLS, "depth", 0) else self.real.write(text)
+
+    def __getattr__(self, name):
+        return getattr(self.real, name)
+
+
+_QUIET_LOCK = threading.Lock()
+_QUIET_TLS = threading.local()
+#: [threads inside _quiet, the stdout and Exudyn printToConsole they replaced]
+_QUIET_STATE = [0, None, None]
+
+
 @contextlib.contextmanager
 def _quiet():
-    """Silence Exudyn console output of a solver call."""
+    """Silence Exudyn console output of a solver call, in this thread only.
+
+    ``contextlib.redirect_stdout`` swaps the process-wide ``sys.stdout``; two threads that
+    overlap (the inversion's selection thread and the main thread both build and solve
+    models) then restore each other's stand-ins, and ``sys.stdout`` stays a StringIO for the
+    rest of the run: the CLI's closing lines vanished intermittently (seen on ``eroad invert
+    --effects auto`` with stdout and stderr in one file). Here the first thread in installs
+    one stand-in (:class:`_QuietStdout`) and the last one out restores what was there; the
+    stand-in drops only the quiet threads' writes.
+    """
     cfg = _exu().config
-    old = cfg.printToConsole
-    cfg.printToConsole = False
+    with _QUIET_LOCK:
+        if _QUIET_STATE[0] == 0:
+            _QUIET_STATE[1], _QUIET_STATE[2] = sys.stdout, cfg.printToConsole
+            sys.stdout = _QuietStdout(sys.stdout)
+            cfg.printToConsole = False
+        _QUIET_STATE[0] += 1
+    _QUIET_TLS.depth = getattr(_QUIET_TLS, "depth", 0) + 1
     try:
-        with contextlib.redirect_stdout(io.StringIO()):
-            yield
+        yield
     finally:
-        cfg.printToConsole = old
+        _QUIET_TLS.depth -= 1
+        with _QUIET_LOCK:
+            _QUIET_STATE[0] -= 1
+            if _QUIET_STATE[0] == 0:
+                sys.stdout, cfg.printToConsole = _QUIET_STATE[1], _QUIET_STATE[2]
+                _QUIET_STATE[1] = _QUIET_STATE[2] = None
 
 
 def _rot_coords(node_type):
