@@ -592,6 +592,8 @@ def load_measured(dataset):
     from drives.format import read_drive
 
     drive = read_drive(dataset)
+    from drives.rate import for_road_methods
+    drive, resampled = for_road_methods(drive)   # a record above 400 Hz: to 200 Hz
     names = [c for c in drive.channel_names if c.startswith(QUANTITIES)]
     if not names:
         raise EroadInputError(f"{dataset}: no susp_disp/axle_acc/body_acc channels to diagnose")
@@ -601,7 +603,8 @@ def load_measured(dataset):
     t = np.asarray(drive.time, float)
     sig = Signals(t - t[0], {c: np.asarray(drive.channels[c], float) for c in names},
                   {c: drive.units.get(c, "") for c in names}, np.asarray(drive.speed, float),
-                  {"dataset": drive.name, "t0": 0.0})
+                  {"dataset": drive.name, "t0": 0.0,
+                   **({"resampled_from_hz": resampled["from_hz"]} if resampled else {})})
     return drive, sig
 
 
@@ -1382,7 +1385,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     calib = held = None
 
     progress(f"dataset {drive.name}: {sig.duration:.1f} s, {len(sig.channels)} channels, "
-             f"vehicle {vp.id}")
+             f"vehicle {vp.id}" + (f"; resampled from {sig.meta['resampled_from_hz']:g} to {sig.fs:g} Hz"
+                                   if "resampled_from_hz" in sig.meta else ""))
     ctx = prepare(sig, veh, seed=seed, n_windows=n_windows, road_fit=road_fit, workers=workers)
     model, calib, held, edges, bounds = ctx.model, ctx.calib, ctx.held, ctx.edges, ctx.bounds
     cal_edges, simc, segs = ctx.cal_edges, ctx.sim_nominal, ctx.segs
@@ -1461,6 +1465,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         # counts from that sample; the report adds this to show record times (as Table 1)
         "record_t0_s": float(np.asarray(drive.time, float)[0]),
         "duration_s": float(T), "channels": list(sig.channels),
+        "sample_rate_hz": float(sig.fs), "resampled_from_hz": sig.meta.get("resampled_from_hz"),
         "road_segments": [{"segment": s[0], "t_start_s": s[1], "t_end_s": s[2],
                            "Gq_n0_m3": float(model.gq[k]), "w": float(model.w[k]),
                            "nmin": float(ROAD_NMIN if model.nmin is None else model.nmin[k]),

@@ -938,6 +938,8 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
     if out.exists() and any(out.iterdir()) and not force:
         raise EroadInputError(f"{out}: exists and is not empty; choose another --out or use --force")
     drive = read_drive(dataset)
+    from drives.rate import for_road_methods
+    drive, resampled = for_road_methods(drive)   # a record above 400 Hz: to 200 Hz
     names = response_channels(drive.channel_names)
     if not names:
         raise EroadInputError(f"{drive.path}: eroad replica needs response channels "
@@ -1042,7 +1044,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
             "format": RUN_FORMAT,
             "dataset": {"name": drive.name, "path": dataset_path(dataset, out), "vehicle": str(drive.vehicle),
                         "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz,
-                        "warnings": list(drive.warnings)},
+                        "warnings": list(drive.warnings), "resampled": resampled},
             "method": "time-domain MAP input estimation on the linear model (docs/replica.md)",
             "lines": {"layout": rep.operator.lines,
                       "tyre_lines": [{"side": side, "y_m": float(yl), "column": line_column(side, yl)}

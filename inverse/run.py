@@ -210,6 +210,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         raise EroadInputError(f"--segments must be an integer in 1..12, got {segments!r}")
     check_out(out, force)
     drive = read_drive(dataset)
+    from drives.rate import for_road_methods
+    drive, resampled = for_road_methods(drive)   # a record above 400 Hz: to 200 Hz
     drive.require(["susp_disp_3L", "susp_disp_3R"], "eroad invert")
     if not np.all(np.asarray(drive.speed) > 0.5):
         from drives.cut import moving_hint
@@ -345,7 +347,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                 "format": RUN_FORMAT,
                 "dataset": {"name": drive.name, "path": dataset_path(dataset, out), "vehicle": str(drive.vehicle),
                             "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz,
-                            "warnings": list(drive.warnings)},
+                            "warnings": list(drive.warnings), "resampled": resampled},
                 "segments": segs,
                 "fit_quality": overall_fit_quality(segs),
                 "table2": rows,

@@ -300,3 +300,27 @@ def test_dead_and_clipped_channels_are_warnings(tmp_path):
     assert {f.column for f in found} == {"axle_acc_3R", "body_acc_3L"} and not any(f.fatal for f in found)
     assert any("constant 0" in f.message for f in found) and any("clipped" in f.message for f in found)
     assert check_signals(_channels(station_frame(seed=10, axles=(3,)))) == []
+
+
+def test_body_factor_rule_weighs_its_standard_error_and_the_noise_bias(monkeypatch):
+    """The rule of the body factor, on given fit results: above the SI range by less than 3
+    standard errors -> nothing; by more -> a warning; at 9.81 -> named and fatal; far below
+    the range (a quiet body under sensor noise biases beta towards 0) -> nothing unless at the
+    mm/s^2 factor 1/1000."""
+    import drives.plausibility as pl
+
+    def finding(beta, se):
+        monkeypatch.setattr(pl, "kinematic_fit", lambda *a: (1.0, beta, 0.9, se))
+        return pl._body_finding("3", np.zeros(2000), None, None, FS)
+
+    assert finding(1.9, 0.2) is None                        # 1.5 + 3 x 0.2 = 2.1
+    f = finding(1.9, 0.05)
+    assert f is not None and not f.fatal and "scale error" in f.message
+    f = finding(9.0, 0.3)
+    assert f.fatal and "body accelerations in g" in f.message
+    assert finding(0.05, 0.01) is None                      # below the range: attenuation, no finding
+    f = finding(0.0011, 0.0001)
+    assert f.fatal and "mm/s^2" in f.message
+    f = finding(-1.0, 0.05)
+    assert not f.fatal and "sign is flipped" in f.message
+    assert finding(-0.1, 0.05) is None                      # sign not determined
