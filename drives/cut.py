@@ -24,12 +24,12 @@ Decisions:
 """
 from __future__ import annotations
 
-import hashlib
 import shutil
 from pathlib import Path
 
 import numpy as np
 
+from eroad.archive import file_sha256
 from drives.format import (CHANNELS_FILE, VEHICLE_FILE, read_drive, swap_into_place,
                            temp_folder_beside, write_drive)
 from eroad.errors import EroadInputError
@@ -66,14 +66,6 @@ def moving_hint(path, time, speed, command: str) -> str:
     return (f"{path}: {command} needs a moving vehicle (speed > {MIN_SPEED:g} m/s throughout); "
             f"the speed is at or below that in {slow_stretches(time, speed)}: "
             f"`eroad data cut {path} --moving --out DIR` writes each moving stretch as a dataset of its own")
-
-
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def cut_dataset(src, out, *, window: tuple[float, float] | None = None, moving: bool = False,
@@ -152,7 +144,7 @@ def cut_dataset(src, out, *, window: tuple[float, float] | None = None, moving: 
     vehicle_file = drive.vehicle if isinstance(drive.vehicle, Path) else None
     if vehicle_file is not None:
         base["vehicle"] = VEHICLE_FILE
-    sha = _sha256(src / CHANNELS_FILE)
+    sha = file_sha256(src / CHANNELS_FILE)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = temp_folder_beside(out) if moving else None
     written = []

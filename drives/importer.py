@@ -69,7 +69,6 @@ The rules (also in ``docs/import.md``)
 from __future__ import annotations
 
 import csv
-import hashlib
 import re
 import math
 import tomllib
@@ -80,6 +79,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from eroad.archive import file_sha256
 from drives.format import (MAX_CSV_BYTES, META_FILE, builtin_vehicles, parse_channel,
                            swap_into_place, temp_folder_beside, write_drive)
 from eroad.errors import EroadInputError
@@ -352,14 +352,6 @@ def read_map(path) -> ImportMap:
 
 
 # --------------------------------------------------------------------------- the logger file
-
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
 
 def _sniff(lines: list[str], raw: Path, header_row: int) -> str:
     """The delimiter that splits the header and the next lines into one equal count >= 2."""
@@ -748,8 +740,8 @@ def import_logger(raw, map_path, out, *, window=None, vehicle=None, speed_mps=No
              "max_rel_jitter": float(np.max(np.abs(cont - med)) / med) if cont.size else 0.0}
     record = {
         "tool": "eroad data import",
-        "source": str(raw), "source_sha256": _sha256(raw),
-        "map": str(m.path), "map_sha256": _sha256(m.path),
+        "source": str(raw), "source_sha256": file_sha256(raw),
+        "map": str(m.path), "map_sha256": file_sha256(m.path),
         "delimiter": tab.delimiter, "delimiter_sniffed": tab.sniffed, "decimal": m.decimal,
         "rows_read": int(tab.time.size),
         "ignored_columns": [c for c in tab.header

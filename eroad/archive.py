@@ -169,6 +169,16 @@ def write_json_atomic(path: str | os.PathLike, obj: Any, *, indent: int = 2) -> 
     return path
 
 
+def file_sha256(path: str | os.PathLike) -> str:
+    """SHA-256 of a file's bytes (hex), read in 1 MiB blocks: the provenance of an input
+    recorded beside what was made from it."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
 def _tomlable(obj: Any) -> Any:
     """Convert a config to types tomli_w accepts; ``None`` entries are dropped
     (TOML has no null: an absent key means "default")."""

@@ -25,7 +25,6 @@ seed of ``roadlib.segments.segmented_surface``); realisation 0 is the road file 
 """
 from __future__ import annotations
 
-import hashlib
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from eroad.archive import file_sha256
 from eroad.errors import EroadInputError
 from studies.figure11 import (DEFAULT_VEHICLE, drive_base_motion, evaluate_findings, max_duration,
                               mode_table, tractor_variant)
@@ -180,14 +180,6 @@ def code_version() -> str:
 # ---------------------------------------------------------------------------
 # roads
 # ---------------------------------------------------------------------------
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
-
-
 def _equivalent_segments(road) -> tuple[list[dict], str]:
     """Segments (RoadSegment fields) statistically equivalent to a road.
 
@@ -254,7 +246,7 @@ def road_specs(road_path: str | Path, n_seeds: int = 2,
         raise EroadInputError(f"--seeds {n_seeds}: must be >= 0")
     path = Path(road_path).resolve()
     road = RoadSurface.load(path)
-    specs = [{"kind": "file", "path": str(path), "sha256": _sha256(path), "label": "road file"}]
+    specs = [{"kind": "file", "path": str(path), "sha256": file_sha256(path), "label": "road file"}]
     how = "no synthetic realisations"
     if n_seeds:
         segs, how = _equivalent_segments(road)
@@ -291,7 +283,7 @@ def build_road(spec: dict):
     if kind == "file":
         path = Path(spec["path"])
         road = RoadSurface.load(path)
-        if spec.get("sha256") and _sha256(path) != spec["sha256"]:
+        if spec.get("sha256") and file_sha256(path) != spec["sha256"]:
             raise EroadInputError(f"{path}: road file changed since the study started")
         return road
     if kind == "segments":
