@@ -124,6 +124,11 @@ def format_summary(s: dict) -> str:
         f"({'speed column' if s['speed_source'] == 'column' else 'constant from meta.toml'})",
         f"vehicle   {s['vehicle']}{' (file in the dataset)' if s['vehicle_is_file'] else ''}",
     ]
+    sc = s.get("speed_check")
+    lines.append("speed chk " + (f"axle-to-axle delay in distance: x{sc['scale']:.3f} of the vehicle's axle "
+                                 f"spacing ({sc['agree']} of {sc['pairs']} axle pairs agree; 1 for a right speed)"
+                                 if sc else "not measured (needs two axles of one side and the vehicle's "
+                                 "axle positions)"))
     lines += [f"warning   {w}" for w in s.get("warnings", [])]
     return "\n".join(lines)
 

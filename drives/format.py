@@ -203,6 +203,10 @@ class Drive:
     warnings : tuple of str
         Plausibility findings that do not refuse the data (``drives.plausibility``):
         one line each, naming the file and column.
+    speed_check : dict or None
+        The speed's distance scale measured by the axle-to-axle delay
+        (``drives.plausibility.speed_delay_scale``: ``scale``, ``pairs``, ``agree``,
+        ``signal``); None where it could not be measured.
     """
 
     path: Path
@@ -214,6 +218,7 @@ class Drive:
     units: dict = field(default_factory=dict)
     speed_source: str = "column"
     warnings: tuple = ()
+    speed_check: dict | None = None
 
     @property
     def name(self) -> str:
@@ -302,7 +307,8 @@ class Drive:
         -------
         dict
             name, n_samples, duration_s, sample_rate_hz, t_start_s, t_end_s,
-            channels, speed_min_mps, speed_max_mps, speed_source, vehicle.
+            channels, speed_min_mps, speed_max_mps, speed_source, vehicle, vehicle_is_file,
+            warnings, speed_check.
         """
         veh = self.vehicle.name if isinstance(self.vehicle, Path) else self.vehicle
         return {
@@ -319,6 +325,7 @@ class Drive:
             "vehicle": veh,
             "vehicle_is_file": isinstance(self.vehicle, Path),
             "warnings": list(self.warnings),
+            "speed_check": self.speed_check,
         }
 
 
@@ -767,13 +774,15 @@ def inspect_drive(folder) -> tuple[list[str], Drive | None]:
         speed, source = np.full(t.size, speed_mps), "meta"
     for c in chans.columns:
         units.setdefault(c, QUANTITIES[parse_channel(c)[0]].unit)
-    from drives.plausibility import check_signals, check_speed, check_units as _physics
+    from drives.plausibility import check_signals, check_speed, check_units as _physics, speed_delay_scale
 
     warnings = []
     arrays = {c: chans[c].to_numpy(float) for c in chans.columns}
     findings = _physics(arrays, 1.0 / step)
     findings += check_signals(arrays)
-    speed_findings = check_speed(arrays, speed, 1.0 / step, axle_positions(vehicle))
+    axle_x = axle_positions(vehicle)
+    delay = speed_delay_scale(arrays, speed, 1.0 / step, axle_x)
+    speed_findings = check_speed(arrays, speed, 1.0 / step, axle_x, estimate=delay)
     if source == "meta":   # the constant speed of meta.toml, not a column
         for f in speed_findings:
             msg = f"[dataset] speed_mps = {speed_mps:g}: {f.message}"
@@ -792,7 +801,8 @@ def inspect_drive(folder) -> tuple[list[str], Drive | None]:
     meta = dict(ds)
     meta.setdefault("name", folder.name)
     return [], Drive(path=folder, time=t, channels=chans, speed=speed, meta=meta,
-                     vehicle=vehicle, units=units, speed_source=source, warnings=tuple(warnings))
+                     vehicle=vehicle, units=units, speed_source=source, warnings=tuple(warnings),
+                     speed_check=delay)
 
 
 def check_drive(path) -> list[str]:

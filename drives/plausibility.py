@@ -434,8 +434,47 @@ def delay_scale(a: np.ndarray, b: np.ndarray, spacing: float, s: np.ndarray,
     return float(lags[i] * step / spacing), float(c[i])
 
 
+def speed_delay_scale(channels: dict, speed: np.ndarray, fs: float,
+                      axle_x: dict | None) -> dict | None:
+    """The speed's distance scale measured by the axle-to-axle delay (:func:`delay_scale` on
+    every pair of axles of a side with a spacing of ``MIN_PAIR_SPACING_M`` or more).
+
+    Returns
+    -------
+    dict or None
+        ``scale`` (median over the pairs: 1 for a right speed) [-], ``pairs`` (used),
+        ``agree`` (pairs within ``SPEED_UNIT_TOL`` of the median), ``signal`` (the channel
+        quantity used); None when fewer than two pairs could be used (no two axles of a
+        side recorded, the vehicle file unknown, too short a record, no clear peak).
+    """
+    speed = np.asarray(speed, float)
+    s = np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1])) / fs])
+    ks, used = [], None
+    for side in "LR":
+        for q in ("axle_acc", "susp_disp"):
+            have = sorted(a for a in (axle_x or {}) if f"{q}_{a}{side}" in channels)
+            if len(have) >= 2:
+                break
+        for i, a in enumerate(have):
+            for b in have[i + 1:]:
+                spacing = abs(axle_x[a] - axle_x[b])
+                if spacing < MIN_PAIR_SPACING_M:
+                    continue
+                k, c = delay_scale(channels[f"{q}_{a}{side}"], channels[f"{q}_{b}{side}"],
+                                   spacing, s, fs)
+                if np.isfinite(k) and c >= MIN_DELAY_CORRELATION:
+                    ks.append(k)
+                    used = q
+    if len(ks) < 2:
+        return None
+    ks = np.array(ks)
+    k = float(np.median(ks))
+    agree = int(np.sum(np.abs(np.log(ks / k)) <= math.log(1.0 + SPEED_UNIT_TOL)))
+    return {"scale": k, "pairs": int(ks.size), "agree": agree, "signal": used}
+
+
 def check_speed(channels: dict, speed: np.ndarray, fs: float,
-                axle_x: dict | None = None) -> list[Finding]:
+                axle_x: dict | None = None, estimate: dict | None = None) -> list[Finding]:
     """Speed plausibility: the axle-to-axle delay against the vehicle's axle spacing, and
     the speed's level against a heavy vehicle's.
 
@@ -450,41 +489,26 @@ def check_speed(channels: dict, speed: np.ndarray, fs: float,
     axle_x : dict, optional
         Axle number (1 = front) -> its position along x [m] from the vehicle file; without
         it only the level is checked.
+    estimate : dict, optional
+        :func:`speed_delay_scale` of these arguments, when the caller has it already.
 
     Returns
     -------
     list of Finding
-        On the column ``speed``. Fatal only for a named unit error found by the delay on at
-        least two axle pairs that agree.
+        On the column ``speed``. Fatal for a named unit error, or a factor beyond
+        ``SPEED_FATAL_FACTOR``, found by at least two axle pairs (and half of them) that agree.
     """
     speed = np.asarray(speed, float)
     out: list[Finding] = []
-    s = np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1])) / fs])
-    pairs = []
-    for side in "LR":
-        for q in ("axle_acc", "susp_disp"):
-            have = sorted(a for a in (axle_x or {}) if f"{q}_{a}{side}" in channels)
-            if len(have) >= 2:
-                break
-        for i, a in enumerate(have):
-            for b in have[i + 1:]:
-                spacing = abs(axle_x[a] - axle_x[b])
-                if spacing < MIN_PAIR_SPACING_M:
-                    continue
-                k, c = delay_scale(channels[f"{q}_{a}{side}"], channels[f"{q}_{b}{side}"],
-                                   spacing, s, fs)
-                if np.isfinite(k) and c >= MIN_DELAY_CORRELATION:
-                    pairs.append((k, c, f"{a}{side}-{b}{side}"))
-    if len(pairs) >= 2:
-        ks = np.array([p[0] for p in pairs])
-        k = float(np.median(ks))
-        agree = int(np.sum(np.abs(np.log(ks / k)) <= math.log(1.0 + SPEED_UNIT_TOL)))
+    est = estimate if estimate is not None else speed_delay_scale(channels, speed, fs, axle_x)
+    if est is not None:
+        k, agree, n = est["scale"], est["agree"], est["pairs"]
         if abs(math.log10(k)) > SPEED_LOG10_TOL:
             text = (f"the axles' signals repeat {k:.3g}x farther apart than the vehicle file's "
                     f"axle spacing, in distance integrated from this speed ({agree} of "
-                    f"{len(pairs)} axle pairs agree)")
+                    f"{n} axle pairs agree)")
             best = min(SPEED_UNIT_ERRORS, key=lambda v: abs(math.log(k / v)))
-            consistent = agree >= 2 and 2 * agree >= len(pairs)
+            consistent = agree >= 2 and 2 * agree >= n
             if abs(math.log(k / best)) <= math.log(1.0 + SPEED_UNIT_TOL) and consistent:
                 out.append(Finding("speed", f"{text}: {SPEED_UNIT_ERRORS[best]}", True))
             elif abs(math.log(k)) > math.log(SPEED_FATAL_FACTOR) and consistent:

@@ -1044,7 +1044,8 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
             "format": RUN_FORMAT,
             "dataset": {"name": drive.name, "path": dataset_path(dataset, out), "vehicle": str(drive.vehicle),
                         "duration_s": drive.duration_s, "sample_rate_hz": drive.sample_rate_hz,
-                        "warnings": list(drive.warnings), "resampled": resampled},
+                        "warnings": list(drive.warnings), "resampled": resampled,
+                        "speed_check": drive.speed_check},
             "method": "time-domain MAP input estimation on the linear model (docs/replica.md)",
             "lines": {"layout": rep.operator.lines,
                       "tyre_lines": [{"side": side, "y_m": float(yl), "column": line_column(side, yl)}

@@ -12,7 +12,7 @@ import pytest
 
 from drives.format import read_drive, write_drive
 from drives.plausibility import (G, check_signals, check_speed, check_units, delay_scale, kinematic_fit,
-                                   kinematic_ratio)
+                                   kinematic_ratio, speed_delay_scale)
 from eroad.cli import main
 from eroad.errors import EroadInputError
 
@@ -258,7 +258,7 @@ def test_speed_scale_from_the_axle_delay(factor, fatal, expect):
 def test_speed_level_without_two_axles_is_a_warning():
     ch, v = road_drive()
     one = {k: x for k, x in ch.items() if k.startswith("axle_acc_3")}
-    assert check_speed(one, v, FS, AXLE_X) == []
+    assert check_speed(one, v, FS, AXLE_X) == [] and speed_delay_scale(one, v, FS, AXLE_X) is None
     found = check_speed(one, v * 3.6, FS, AXLE_X)
     assert len(found) == 1 and not found[0].fatal and "in km/h?" in found[0].message
     assert check_speed(ch, v * 3.6, FS, None)[0].fatal is False   # no vehicle file: level only
@@ -271,7 +271,10 @@ def test_independent_truck_drive_passes_and_its_kmh_speed_is_refused(tmp_path, c
     from drives.synth import synth_command
     out = tmp_path / "second"
     synth_command(scenario="second", seed=21, duration=10.0, out=out)
-    assert not any("speed" in w for w in read_drive(out).warnings)
+    d = read_drive(out)
+    assert not any("speed" in w for w in d.warnings)
+    assert d.speed_check["scale"] == pytest.approx(1.0, abs=0.03) and d.speed_check["agree"] >= 2
+    assert d.summary()["speed_check"] == d.speed_check
     df = pd.read_csv(out / "channels.csv")
     df["speed"] = df["speed"] * 3.6
     df.to_csv(out / "channels.csv", index=False, float_format="%.17g")
