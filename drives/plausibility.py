@@ -382,10 +382,11 @@ SPEED_UNIT_TOL = 0.1
 HEAVY_VEHICLE_MAX_SPEED = 120.0 / 3.6
 
 
-def _along_distance(x: np.ndarray, s: np.ndarray, grid: np.ndarray, fs: float) -> np.ndarray:
+def _band_delay(x: np.ndarray, fs: float) -> np.ndarray:
+    """``x`` band-passed to ``DELAY_BAND_HZ`` in time (before any resampling in distance)."""
     hi = min(DELAY_BAND_HZ[1], 0.4 * fs)
     sos = butter(4, [DELAY_BAND_HZ[0], hi], btype="band", fs=fs, output="sos")
-    return np.interp(grid, s, sosfiltfilt(sos, np.asarray(x, float) - np.mean(x)))
+    return sosfiltfilt(sos, np.asarray(x, float) - np.mean(x))
 
 
 def delay_scale(a: np.ndarray, b: np.ndarray, spacing: float, s: np.ndarray,
@@ -411,12 +412,13 @@ def delay_scale(a: np.ndarray, b: np.ndarray, spacing: float, s: np.ndarray,
     corr : float
         The peak's correlation coefficient [-].
     """
-    keep = np.concatenate([[True], np.diff(s) > 0])   # standstill: one sample per position
-    s, a, b = s[keep], np.asarray(a, float)[keep], np.asarray(b, float)[keep]
-    if s[-1] - s[0] < MIN_SPACINGS_COVERED * spacing * DELAY_SCALE_RANGE[1] / 5.0:
+    if s[-1] - s[0] < MIN_SPACINGS_COVERED * spacing:
         return float("nan"), 0.0
+    a, b = _band_delay(a, fs), _band_delay(b, fs)     # filtered in time, on the uniform grid
+    keep = np.concatenate([[True], np.diff(s) > 0])   # standstill: one sample per position
+    s, a, b = s[keep], a[keep], b[keep]
     grid = np.arange(s[0], s[-1], min(DELAY_GRID_M, spacing / 40.0))
-    fa, fb = _along_distance(a, s, grid, fs), _along_distance(b, s, grid, fs)
+    fa, fb = np.interp(grid, s, a), np.interp(grid, s, b)
     step = grid[1] - grid[0]
     lags = np.arange(int(DELAY_SCALE_RANGE[0] * spacing / step),
                      min(int(DELAY_SCALE_RANGE[1] * spacing / step), grid.size // 2) + 1)
