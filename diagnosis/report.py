@@ -291,7 +291,8 @@ def plot_transmissibility(summary: Mapping, path: str | os.PathLike) -> Path:
     pairs = T["pairs"]
     ncol = 2 if len(pairs) > 2 else 1      # left and right side by side
     nrow = -(-len(pairs) // ncol)
-    fig = Figure(figsize=(5.5 * ncol, 1.2 + 1.7 * nrow), layout="constrained")
+    # one column (a drive logged on one axle) at 8 in, so that the title and legend fit
+    fig = Figure(figsize=(5.5 * ncol if ncol > 1 else 8.0, 1.4 + 1.7 * nrow), layout="constrained")
     axes = list(fig.subplots(nrow, ncol, squeeze=False, sharex=True).ravel())
     for ax in axes[len(pairs):]:
         ax.set_visible(False)
@@ -314,7 +315,7 @@ def plot_transmissibility(summary: Mapping, path: str | os.PathLike) -> Path:
     fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=3, fontsize=7)
     for ax in axes[max(0, len(pairs) - ncol):len(pairs)]:
         ax.set_xlabel("third-octave band centre [Hz]", fontsize=8)
-    fig.suptitle("axle-to-body transmissibility (single input), ln|H_sim| - ln|H_meas| per band: "
+    fig.suptitle("axle-to-body transmissibility (single input), ln|H_sim| - ln|H_meas| per band:\n"
                  "mostly the vehicle's, but on a multi-axle truck the road's cross-track coherence "
                  "still enters", fontsize=9)
     fig.savefig(path, dpi=130)
