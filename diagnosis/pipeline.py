@@ -592,14 +592,13 @@ def load_measured(dataset):
     from drives.format import read_drive
 
     drive = read_drive(dataset)
+    from drives.cut import require_moving
     from drives.rate import for_road_methods
-    drive, resampled = for_road_methods(drive)   # a record above 400 Hz: to 200 Hz
+    drive, resampled = for_road_methods(drive)   # above the vehicle's solver rate: to 200 Hz
     names = [c for c in drive.channel_names if c.startswith(QUANTITIES)]
     if not names:
         raise EroadInputError(f"{dataset}: no susp_disp/axle_acc/body_acc channels to diagnose")
-    if not np.all(np.asarray(drive.speed) > 0.5):   # the road model runs in distance
-        from drives.cut import moving_hint
-        raise EroadInputError(moving_hint(drive.path, drive.time, drive.speed, "eroad diagnose"))
+    require_moving(drive, "eroad diagnose")   # the road methods run in distance
     t = np.asarray(drive.time, float)
     sig = Signals(t - t[0], {c: np.asarray(drive.channels[c], float) for c in names},
                   {c: drive.units.get(c, "") for c in names}, np.asarray(drive.speed, float),

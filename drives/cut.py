@@ -61,11 +61,17 @@ def slow_stretches(time: np.ndarray, speed: np.ndarray, min_speed: float = MIN_S
     return text + (f" and {len(slow) - most} more" if len(slow) > most else "")
 
 
-def moving_hint(path, time, speed, command: str) -> str:
-    """The one-line refusal of a road method on a drive that does not move throughout."""
-    return (f"{path}: {command} needs a moving vehicle (speed > {MIN_SPEED:g} m/s throughout); "
-            f"the speed is at or below that in {slow_stretches(time, speed)}: "
-            f"`eroad data cut {path} --moving --out DIR` writes each moving stretch as a dataset of its own")
+def require_moving(drive, command: str) -> None:
+    """Refuse, with one line, a drive whose speed is at or below ``MIN_SPEED`` anywhere: the
+    road methods (``command``: "eroad invert", "eroad diagnose", "eroad replica") turn time
+    into distance with it. The line names the slow stretches and the cut that helps."""
+    if np.all(np.asarray(drive.speed, float) > MIN_SPEED):
+        return
+    raise EroadInputError(
+        f"{drive.path}: {command} needs a moving vehicle (speed > {MIN_SPEED:g} m/s throughout); "
+        f"the speed is at or below that in {slow_stretches(drive.time, drive.speed)}: "
+        f"`eroad data cut {drive.path} --moving --out DIR` writes each moving stretch as a dataset "
+        f"of its own")
 
 
 def cut_dataset(src, out, *, window: tuple[float, float] | None = None, moving: bool = False,

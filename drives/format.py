@@ -165,15 +165,19 @@ def builtin_vehicles() -> tuple[str, ...]:
     -------
     tuple of str
     """
+    stems = [p.stem for d in _builtin_params_dirs() for p in d.glob("*.toml")]
+    return tuple(sorted(set(stems))) or BUILTIN_VEHICLES_FALLBACK
+
+
+def _builtin_params_dirs() -> list[Path]:
+    """The folders of the built-in vehicle files (``vehicles/params``), found without
+    importing :mod:`vehicles`."""
     try:
         spec = importlib.util.find_spec("vehicles")
     except (ImportError, ValueError):
         spec = None
-    stems: list[str] = []
-    if spec is not None and spec.submodule_search_locations:
-        for loc in spec.submodule_search_locations:
-            stems += [p.stem for p in Path(loc, "params").glob("*.toml")]
-    return tuple(sorted(set(stems))) or BUILTIN_VEHICLES_FALLBACK
+    locs = (spec.submodule_search_locations or []) if spec is not None else []
+    return [Path(loc, "params") for loc in locs]
 
 
 @dataclass(frozen=True)
@@ -659,13 +663,8 @@ def axle_positions(vehicle) -> dict[int, float] | None:
     that where the vehicle is used)."""
     path = Path(vehicle) if isinstance(vehicle, Path) else None
     if path is None:
-        try:
-            spec = importlib.util.find_spec("vehicles")
-        except (ImportError, ValueError):
-            spec = None
-        for loc in (spec.submodule_search_locations or []) if spec is not None else []:
-            if Path(loc, "params", f"{vehicle}.toml").is_file():
-                path = Path(loc, "params", f"{vehicle}.toml")
+        path = next((d / f"{vehicle}.toml" for d in _builtin_params_dirs()
+                     if (d / f"{vehicle}.toml").is_file()), None)
     try:
         axles = tomllib.loads(path.read_text())["axle"]
         return {i + 1: float(a["x"]) for i, a in enumerate(axles)}

@@ -112,10 +112,22 @@ class Finding:
     fatal: bool
 
 
-def _band(x: np.ndarray, fs: float) -> np.ndarray:
-    hi = min(BAND_HZ[1], 0.4 * fs)
-    sos = butter(4, [BAND_HZ[0], hi], btype="band", fs=fs, output="sos")
+def _band(x: np.ndarray, fs: float, band: tuple = BAND_HZ) -> np.ndarray:
+    """``x`` less its mean, zero-phase band-passed (4th-order Butterworth) to ``band`` [Hz],
+    the top held below 0.4 fs."""
+    x = np.asarray(x, float)
+    sos = butter(4, [band[0], min(band[1], 0.4 * fs)], btype="band", fs=fs, output="sos")
     return sosfiltfilt(sos, x - np.mean(x))
+
+
+def _second_difference(x: np.ndarray, fs: float) -> np.ndarray:
+    """Compact second difference of ``x`` [unit/s^2] (0.984 of s'' at 15 Hz with 200 Hz
+    sampling), the end samples repeated."""
+    x = np.asarray(x, float)
+    s2 = np.empty_like(x)
+    s2[1:-1] = (x[2:] - 2.0 * x[1:-1] + x[:-2]) * fs * fs
+    s2[0], s2[-1] = s2[1], s2[-2]
+    return s2
 
 
 def kinematic_ratio(susp: np.ndarray, axle_acc: np.ndarray, body_acc: np.ndarray | None,
@@ -138,10 +150,7 @@ def kinematic_ratio(susp: np.ndarray, axle_acc: np.ndarray, body_acc: np.ndarray
     corr : float
         Correlation of the two band-passed signals [-].
     """
-    x = np.asarray(susp, float)
-    s2 = np.empty_like(x)   # compact second difference: 0.984 of s'' at 15 Hz, 200 Hz sampling
-    s2[1:-1] = (x[2:] - 2.0 * x[1:-1] + x[:-2]) * fs * fs
-    s2[0], s2[-1] = s2[1], s2[-2]
+    s2 = _second_difference(susp, fs)
     a = np.asarray(axle_acc, float) - (0.0 if body_acc is None else np.asarray(body_acc, float))
     a_b, s_b = _band(a, fs), _band(s2, fs)
     ra, rs = float(np.std(a_b)), float(np.std(s_b))
@@ -172,15 +181,10 @@ def kinematic_fit(susp: np.ndarray, axle_acc: np.ndarray, body_acc: np.ndarray,
         Standard error of beta [-], from the residual over 2 x bandwidth x duration
         independent samples (a body that barely moves above this axle gives a large one).
     """
-    x = np.asarray(susp, float)
-    s2 = np.empty_like(x)
-    s2[1:-1] = (x[2:] - 2.0 * x[1:-1] + x[:-2]) * fs * fs
-    s2[0], s2[-1] = s2[1], s2[-2]
+    n = len(susp)
     hi = min(FIT_BAND_HZ[1], 0.4 * fs)
-    sos = butter(4, [FIT_BAND_HZ[0], hi], btype="band", fs=fs, output="sos")
-    y = sosfiltfilt(sos, s2 - np.mean(s2))
-    a = sosfiltfilt(sos, np.asarray(axle_acc, float) - np.mean(axle_acc))
-    b = sosfiltfilt(sos, np.asarray(body_acc, float) - np.mean(body_acc))
+    y = _band(_second_difference(susp, fs), fs, FIT_BAND_HZ)
+    a, b = _band(axle_acc, fs, FIT_BAND_HZ), _band(body_acc, fs, FIT_BAND_HZ)
     if not (np.std(a) > 0 and np.std(b) > 0 and np.std(y) > 0):
         return float("nan"), float("nan"), 0.0, float("inf")
     design = np.c_[a, -b]
@@ -188,8 +192,8 @@ def kinematic_fit(susp: np.ndarray, axle_acc: np.ndarray, body_acc: np.ndarray,
     r = y - design @ coef
     # standard error of beta: band-passed samples are correlated, so the residual variance
     # counts n_eff = 2 x bandwidth x duration independent samples, not every sample
-    n_eff = max(2.0 * (hi - FIT_BAND_HZ[0]) * x.size / fs, 3.0)
-    cov = np.var(r) * np.linalg.inv(design.T @ design) * (x.size / n_eff)
+    n_eff = max(2.0 * (hi - FIT_BAND_HZ[0]) * n / fs, 3.0)
+    cov = np.var(r) * np.linalg.inv(design.T @ design) * (n / n_eff)
     return (float(coef[0]), float(coef[1]), float(1.0 - np.var(r) / np.var(y)),
             float(np.sqrt(max(cov[1, 1], 0.0))))
 
@@ -382,13 +386,6 @@ SPEED_UNIT_TOL = 0.1
 HEAVY_VEHICLE_MAX_SPEED = 120.0 / 3.6
 
 
-def _band_delay(x: np.ndarray, fs: float) -> np.ndarray:
-    """``x`` band-passed to ``DELAY_BAND_HZ`` in time (before any resampling in distance)."""
-    hi = min(DELAY_BAND_HZ[1], 0.4 * fs)
-    sos = butter(4, [DELAY_BAND_HZ[0], hi], btype="band", fs=fs, output="sos")
-    return sosfiltfilt(sos, np.asarray(x, float) - np.mean(x))
-
-
 def delay_scale(a: np.ndarray, b: np.ndarray, spacing: float, s: np.ndarray,
                 fs: float) -> tuple[float, float]:
     """Distance scale of the speed from one axle pair of one side.
@@ -414,7 +411,7 @@ def delay_scale(a: np.ndarray, b: np.ndarray, spacing: float, s: np.ndarray,
     """
     if s[-1] - s[0] < MIN_SPACINGS_COVERED * spacing:
         return float("nan"), 0.0
-    a, b = _band_delay(a, fs), _band_delay(b, fs)     # filtered in time, on the uniform grid
+    a, b = _band(a, fs, DELAY_BAND_HZ), _band(b, fs, DELAY_BAND_HZ)   # in time, on the uniform grid
     keep = np.concatenate([[True], np.diff(s) > 0])   # standstill: one sample per position
     s, a, b = s[keep], a[keep], b[keep]
     grid = np.arange(s[0], s[-1], min(DELAY_GRID_M, spacing / 40.0))

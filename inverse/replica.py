@@ -938,16 +938,15 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
     if out.exists() and any(out.iterdir()) and not force:
         raise EroadInputError(f"{out}: exists and is not empty; choose another --out or use --force")
     drive = read_drive(dataset)
+    from drives.cut import require_moving
     from drives.rate import for_road_methods
-    drive, resampled = for_road_methods(drive)   # a record above 400 Hz: to 200 Hz
+    drive, resampled = for_road_methods(drive)   # above the vehicle's solver rate: to 200 Hz
     names = response_channels(drive.channel_names)
     if not names:
         raise EroadInputError(f"{drive.path}: eroad replica needs response channels "
                               f"(susp_disp_*, axle_acc_*, body_acc_*); present: "
                               f"{', '.join(drive.channel_names) or 'none'}")
-    if not np.all(np.asarray(drive.speed) > 0.5):
-        from drives.cut import moving_hint
-        raise EroadInputError(moving_hint(drive.path, drive.time, drive.speed, "eroad replica"))
+    require_moving(drive, "eroad replica")   # the road methods run in distance
     chans = {c: drive.channels[c].to_numpy(float) for c in names}
     lm, left_out, lin_notes = replica_linear_model(drive.vehicle, effects, chans, drive.sample_rate_hz)
     missing = [c for c in names if c not in lm.channel_names]

@@ -210,12 +210,11 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         raise EroadInputError(f"--segments must be an integer in 1..12, got {segments!r}")
     check_out(out, force)
     drive = read_drive(dataset)
+    from drives.cut import require_moving
     from drives.rate import for_road_methods
-    drive, resampled = for_road_methods(drive)   # a record above 400 Hz: to 200 Hz
+    drive, resampled = for_road_methods(drive)   # above the vehicle's solver rate: to 200 Hz
     drive.require(["susp_disp_3L", "susp_disp_3R"], "eroad invert")
-    if not np.all(np.asarray(drive.speed) > 0.5):
-        from drives.cut import moving_hint
-        raise EroadInputError(moving_hint(drive.path, drive.time, drive.speed, "eroad invert"))
+    require_moving(drive, "eroad invert")   # the road methods run in distance
     n_cand = int(candidates if candidates is not None else (6 if quick else 16))
     iters = int(max_iter if max_iter is not None else (3 if quick else 12))
     if n_cand < 0 or iters < 1:
