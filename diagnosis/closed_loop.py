@@ -87,14 +87,15 @@ def loop_channels(verdict: str | None, channels=None) -> tuple:
     """The fitted channels of a closed loop's inversions and the phrase that says why.
 
     ``channels`` given by the caller are kept (the phrase is empty); None: ``axles``
-    (:data:`CHANNELS_WHEN_NONE`) where the verdict is ``none``, else axle 3.
+    (:data:`CHANNELS_WHEN_NONE`) where the verdict is ``none``, else None: the inversion's
+    default, axle 3 (or the reference axle of a drive logged elsewhere, ``inverse.run.reference_axle``).
     """
     if channels is not None:
         return channels, ""
     if verdict == "none":
         return CHANNELS_WHEN_NONE, ("no gap beyond noise, so the accelerations of every axle are fitted "
                                     "(channel set 'axles')")
-    return "axle3", ""
+    return None, ""
 
 
 def model_form(verdict: str | None, corrected: bool) -> str:

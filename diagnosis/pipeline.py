@@ -620,12 +620,26 @@ def windows(sig: Signals, n_windows: int = 4):
     return cal, held, edges
 
 
+def segment_axle(names) -> int:
+    """The axle whose suspension displacements segment the record (the reference axle of
+    :class:`TruckModel`): axle 3 where logged, else the lowest-numbered axle logged on both
+    sides (``inverse.run.reference_axle``), else the lowest-numbered one logged at all."""
+    from inverse.run import PREFERRED_AXLE, paired_axles
+
+    axles = paired_axles(names) or sorted({int(c[len("susp_disp_"):-1]) for c in names
+                                           if c.startswith("susp_disp_") and c[len("susp_disp_"):-1].isdigit()})
+    if not axles:
+        raise EroadInputError("diagnosis: no suspension displacement channel (susp_disp_*) to segment the road on")
+    return PREFERRED_AXLE if PREFERRED_AXLE in axles else axles[0]
+
+
 def road_segments(sig: Signals, k=None):
-    """Segment boundaries [s] from the suspension displacements (inverse.segmentation)."""
+    """Segment boundaries [s] from the suspension displacements of :func:`segment_axle`
+    (inverse.segmentation)."""
     from inverse.segmentation import segment
 
-    disp = {c: x for c, x in sig.channels.items() if c.startswith("susp_disp_3")} or \
-        {c: x for c, x in sig.channels.items() if c.startswith("susp_disp_")}
+    a = segment_axle(list(sig.channels))
+    disp = {c: x for c, x in sig.channels.items() if c in (f"susp_disp_{a}L", f"susp_disp_{a}R")}
     res = segment(sig.time, disp, sig.speed, k=k)
     b = np.asarray(res.t_bounds, float)
     b[0], b[-1] = 0.0, sig.time.size / sig.fs
@@ -1064,17 +1078,20 @@ def inverse_road(sig: Signals, vehicle, workers: int = 2):
 
     chans = dict(sig.channels)
 
+    a = segment_axle(list(chans))
+    seg = sorted(c for c in chans if c in (f"susp_disp_{a}L", f"susp_disp_{a}R"))
+
     def make(t_bounds):
-        return TruckSimulator(str(vehicle), sig.time, sig.speed, t_bounds, list(chans))
+        return TruckSimulator(str(vehicle), sig.time, sig.speed, t_bounds, list(chans), ref_axle=a)
 
     cfg = InversionConfig(fit=FitConfig(n_workers=1))
+    predict = truck_predict_rms(str(vehicle), tuple(seg))
     if workers > 1:
         with process_pool(workers) as pool:
-            inv = invert(sig.time, chans, sig.speed, make, predict_rms=truck_predict_rms(str(vehicle)),
-                         config=cfg, map_fn=pool.map)
+            inv = invert(sig.time, chans, sig.speed, make, predict_rms=predict, config=cfg, map_fn=pool.map,
+                         segment_channels=seg)
     else:
-        inv = invert(sig.time, chans, sig.speed, make, predict_rms=truck_predict_rms(str(vehicle)),
-                     config=cfg)
+        inv = invert(sig.time, chans, sig.speed, make, predict_rms=predict, config=cfg, segment_channels=seg)
     rows = inv.segments()
     b = np.asarray(inv.t_bounds, float)
     b[0], b[-1] = 0.0, sig.time.size / sig.fs
@@ -1099,12 +1116,12 @@ def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fi
     if road_fit == "inverse":
         bounds, par = inverse_road(sig, vehicle, workers)
         model = TruckModel(vehicle, sig.time, sig.speed, bounds, par[:, 0].copy(), noise,
-                           list(sig.channels), w=par[:, 1].copy(), nmin=par[:, 2].copy(),
-                           nmax=par[:, 3].copy())
+                           list(sig.channels), ref_axle=segment_axle(list(sig.channels)), w=par[:, 1].copy(),
+                           nmin=par[:, 2].copy(), nmax=par[:, 3].copy())
     elif road_fit == "levels":
         bounds = road_segments(sig)
         model = TruckModel(vehicle, sig.time, sig.speed, bounds, np.full(len(bounds) - 1, GQ_REF),
-                           noise, list(sig.channels))
+                           noise, list(sig.channels), ref_axle=segment_axle(list(sig.channels)))
         model.gq, model.w = fit_road(model, sig, cal_edges, seed)
     else:
         raise EroadInputError(f"road_fit must be 'levels' or 'inverse', got {road_fit!r}")

@@ -92,7 +92,7 @@ def _invert_one(runner: str, dataset: str, out: str, kwargs: dict, argv: list) -
     return {"dataset": dataset, "run": out, "status": "complete", "error": None,
             "wall_s": _time.perf_counter() - t0, "classes": [s.get("class") for s in segs],
             "fit_quality": summary.get("fit_quality", {}).get("status"),
-            "rms_err": {c: e[c].get("rms_err") for c in ("axle_acc_3L", "axle_acc_3R") if c in e}}
+            "rms_err": {c: v.get("rms_err") for c, v in e.items() if c.startswith("axle_acc_")}}
 
 
 def invert_many(datasets, root, *, scheduler=None, n_workers: int = 2, runner: str = DEFAULT_RUNNER,

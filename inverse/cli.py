@@ -46,9 +46,11 @@ def register(subparsers) -> None:
                    help="phase realisations tried in the selection (default 16, 6 with --quick; 0: keep the fit's)")
     p.add_argument("--max-iter", type=int, default=None, help="most fit iterations (default 12, 3 with --quick)")
     p.add_argument("--channels", default=None,
-                   help="fitted channels: 'axle3' (susp_disp and axle_acc 3L,3R; the default), 'axles' "
-                        "(axle_acc of every axle + susp_disp 3L,3R; the default of --effects auto where the "
-                        "diagnosis finds no gap), 'all' (every response channel), or a comma list")
+                   help="fitted channels: default susp_disp and axle_acc of both sides of axle 3 (of the "
+                        "lowest-numbered axle logged on both sides where axle 3 is not), 'axle<N>' (those of "
+                        "axle N, e.g. axle3), 'axles' (axle_acc of every axle + that axle's susp_disp; the "
+                        "default of --effects auto where the diagnosis finds no gap), 'all' (every response "
+                        "channel), or a comma list")
     p.add_argument("--effect", action="append", default=[], metavar="NAME[.PARAM]=VALUE",
                    help="effect added to the nominal model (repeatable), e.g. leaf_friction")
     p.add_argument("--effects", choices=("auto",), default=None,
@@ -113,10 +115,11 @@ def _cmd_invert(args) -> int:
                 return (f"{c} RMS err {100 * e[c]['rms_err']:+.1f}% "
                         f"[{100 * e[c]['rms_err_p16']:+.1f}, {100 * e[c]['rms_err_p84']:+.1f}]")
             return f"{c} RMS err {100 * e[c]['rms_err']:+.1f}%"
-        errs = ", ".join(err(c) for c in ("axle_acc_3L", "axle_acc_3R") if c in e)
+        ref = summary.get("fit", {}).get("reference_axle", 3)
+        errs = ", ".join(err(c) for c in (f"axle_acc_{ref}L", f"axle_acc_{ref}R") if c in e)
         print(f"wrote {args.out}: K = {len(segs)} segments, classes {' '.join(s['class'] for s in segs)}"
               + (f"; {errs} (median [16-84 %] over road realisations)" if errs else
-                 "; no Table 2 headline (axle 3's accelerations were not fitted)")
+                 f"; no Table 2 headline (axle {ref}'s accelerations were not fitted)")
               + f" ({summary['timing']['total_s']:.1f} s wall)")
         for w in summary["dataset"].get("warnings", []):
             print(f"warning: {args.dataset}/{w}")

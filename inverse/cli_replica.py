@@ -31,9 +31,10 @@ def register(subparsers) -> None:
     p.add_argument("--noise", action="append", default=[], metavar="NAME=SD",
                    help="known white sensor noise (sd, SI unit) per channel or quantity, e.g. axle_acc=0.03; "
                         "repeatable; the rest is estimated from the top of each spectrum")
-    p.add_argument("--holdout", default="2", metavar="AXLE|none",
+    p.add_argument("--holdout", default="auto", metavar="AXLE|none",
                    help="axle whose channels are left out of a second reconstruction and predicted from it "
-                        "(validation, shown in red in figures/replica_time.png; default 2; 'none' skips it)")
+                        "(validation, shown in red in figures/replica_time.png; default: axle 2 where logged "
+                        "besides another axle; 'none' skips it; a drive logged on one axle has none)")
     p.add_argument("--diagnosis", default=None, metavar="RUN",
                    help="with --effects auto: an existing 'eroad diagnose' run folder of this dataset "
                         "(otherwise the diagnosis runs first, about 2 minutes)")
@@ -51,6 +52,8 @@ def register(subparsers) -> None:
 def _holdout(value: str):
     if value.strip().lower() == "none":
         return None
+    if value.strip().lower() == "auto":
+        return "auto"
     try:
         a = int(value)
     except ValueError:
@@ -94,6 +97,8 @@ def _cmd_replica(args) -> int:
     if ho["channels"]:
         worst = max(ho["nrmse"].values())
         line += f"; axle {ho['axle']} held out: nRMSE <= {worst:.2f}"
+    elif ho.get("note"):
+        line += f"; {ho['note']}"
     print(line + f" ({summary['timing']['total_s']:.0f} s wall)")
     if "closed_loop" in summary:
         print(f"closed loop: {summary['closed_loop']['reason']}")

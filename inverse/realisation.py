@@ -35,9 +35,15 @@ from inverse.validation import response_table
 #: spawn key prefix of the candidate phase seeds
 SEED_KEY_CANDIDATES = (5, 3)
 
-#: default channels of the selection statistic: Table 2 (axle 3, both sides) RMS
-#: of the acceleration and of the suspension displacement
-SELECT_CHANNELS = ("axle_acc_3L", "axle_acc_3R", "susp_disp_3L", "susp_disp_3R")
+def select_channels(axle: int = 3) -> tuple:
+    """Channels of the selection statistic: Table 2's axle (axle 3, or the reference axle of
+    a drive logged elsewhere), both sides, RMS of the acceleration and of the suspension
+    displacement."""
+    return (f"axle_acc_{axle}L", f"axle_acc_{axle}R", f"susp_disp_{axle}L", f"susp_disp_{axle}R")
+
+
+#: default channels of the selection statistic (axle 3)
+SELECT_CHANNELS = select_channels(3)
 
 
 def candidate_seeds(root: int, m: int) -> list:
@@ -47,9 +53,18 @@ def candidate_seeds(root: int, m: int) -> list:
     return [stream_seed(root, SEED_KEY_CANDIDATES + (i,)) for i in range(int(m))]
 
 
-#: weight of each channel's terms in the statistic: Table 2 is about acceleration;
+#: weight of each channel kind's terms in the statistic: Table 2 is about acceleration;
 #: the displacement keeps the choice from a realisation with a wrong travel
-SELECT_WEIGHTS = {"axle_acc_3L": 1.0, "axle_acc_3R": 1.0, "susp_disp_3L": 0.25, "susp_disp_3R": 0.25}
+SELECT_WEIGHT_DISP = 0.25
+
+
+def select_weights(axle: int = 3) -> dict:
+    """Channel -> weight of the selection statistic for :func:`select_channels` ``(axle)``."""
+    return {c: (SELECT_WEIGHT_DISP if c.startswith("susp_disp_") else 1.0) for c in select_channels(axle)}
+
+
+#: the weights of axle 3's statistic
+SELECT_WEIGHTS = select_weights(3)
 
 
 def mismatch(measured: dict, simulated: dict, channels=SELECT_CHANNELS, use_mean_abs: bool = True,
@@ -84,7 +99,6 @@ def mismatch_stats(measured: dict, simulated: dict, channels=SELECT_CHANNELS, us
                    weights=None) -> float:
     """:func:`mismatch` from per-channel statistics (``inverse.linear_response.channel_stats``:
     channel -> {"rms", "mean_abs"}) instead of signals; same value."""
-    weights = SELECT_WEIGHTS if weights is None else weights
     total = 0.0
     for c in channels:
         if c not in measured or c not in simulated:
@@ -93,7 +107,8 @@ def mismatch_stats(measured: dict, simulated: dict, channels=SELECT_CHANNELS, us
         term = math.log(s["rms"] / m["rms"]) ** 2
         if use_mean_abs and "_acc_" in c:
             term += math.log(s["mean_abs"] / m["mean_abs"]) ** 2
-        total += weights.get(c, 1.0) * term
+        w = weights.get(c, 1.0) if weights is not None else (SELECT_WEIGHT_DISP if c.startswith("susp_disp_") else 1.0)
+        total += w * term
     return float(total)
 
 

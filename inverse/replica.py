@@ -885,7 +885,25 @@ def replica_surface(rep: Replica):
     return RoadSurface(rep.x, y, z, meta)
 
 
-def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: bool = False,
+def _holdout_axle(holdout, names) -> tuple:
+    """The held-out axle of :func:`run_replica` and a note (empty unless none could be held
+    out); an axle asked for that cannot be held out is refused before any reconstruction."""
+    axles = sorted({a for a in (axle_of(c) for c in names) if a is not None})
+    if holdout is None:
+        return None, "no axle held out (--holdout none)"
+    if holdout == "auto":
+        if len(axles) < 2:
+            return None, (f"no axle held out: the drive logs one axle ({', '.join(map(str, axles))}), so the "
+                          "replica cannot be checked against channels it was not made from")
+        return (2 if 2 in axles else axles[-1]), ""
+    a = int(holdout)
+    if a not in axles or len(axles) < 2:
+        raise EroadInputError(f"--holdout {a}: the drive has no channels of axle {a}, or only those (axles "
+                              f"logged: {', '.join(map(str, axles)) or 'none'}); use --holdout none")
+    return a, ""
+
+
+def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout="auto", force: bool = False,
                 argv=None, progress=None, lines: str = "tyre", inversion=None) -> dict:
     """``eroad replica``: reconstruct, score the hold-out, write the run folder.
 
@@ -908,9 +926,11 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
         Effects of the linear model (nonlinear ones are left out, as in the linear fit).
     noise_sd : dict, optional
         Channel or quantity -> sensor noise sd [SI]; the rest estimated.
-    holdout : int or None
+    holdout : int, "auto" or None
         Axle whose channels are left out of a second reconstruction and predicted
-        from it (validation); None: none.
+        from it (validation); None: none; "auto" (default): axle 2 where the drive
+        logs it and another axle, else the highest-numbered of two or more logged axles,
+        else none (a drive logged on one axle has nothing to hold out; the summary says so).
     lines : {"tyre", "track"}
         Unknowns per side: a line per lateral tyre position (default) or one track.
     inversion : str or Path, optional
@@ -947,6 +967,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
                               f"(susp_disp_*, axle_acc_*, body_acc_*); present: "
                               f"{', '.join(drive.channel_names) or 'none'}")
     require_moving(drive, "eroad replica")   # the road methods run in distance
+    holdout, holdout_note = _holdout_axle(holdout, names)
     chans = {c: drive.channels[c].to_numpy(float) for c in names}
     lm, left_out, lin_notes = replica_linear_model(drive.vehicle, effects, chans, drive.sample_rate_hz)
     missing = [c for c in names if c not in lm.channel_names]
@@ -965,9 +986,6 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
     if holdout is not None:
         held = [c for c in names if axle_of(c) == int(holdout)]
         keep = [c for c in names if axle_of(c) != int(holdout)]
-        if not held or not keep:
-            raise EroadInputError(f"--holdout {holdout}: the drive has no channels of axle {holdout}, or "
-                                  f"only those")
         lm2 = lm if not lin_notes else replica_linear_model(      # no held-out data in the linearisation
             drive.vehicle, effects, {c: chans[c] for c in keep}, drive.sample_rate_hz)[0]
         rep2 = reconstruct(lm2, drive.time, drive.speed, {c: chans[c] for c in keep}, noise=noise,
@@ -1064,7 +1082,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout=2, force: 
                                "em": rep.info["em"]},
             "channels": {"used": names, "sigma_used": rep.sigma, "sigma_sensor": rep.sigma_sensor,
                          "fit_nrmse": fit_scores},
-            "holdout": {"axle": holdout, "channels": held, "nrmse": holdout_scores,
+            "holdout": {"axle": holdout, "channels": held, "nrmse": holdout_scores, "note": holdout_note,
                         "nrmse_definition": "RMS(pred - meas) / RMS(meas), means removed"},
             "iri_m_per_km": iri,
             "psd_iso_fit": fits,
@@ -1101,7 +1119,12 @@ def write_replica_figures(folder, drive, rep: Replica, est_l, est_r, fits, held,
     import matplotlib.pyplot as plt
 
     t = np.asarray(drive.time, float)
-    shown = [c for c in ("susp_disp_3L", "axle_acc_3L", "body_acc_3R") if c in rep.fitted]
+    # one channel of each kind, axle 3's where fitted (the paper's), else the first fitted
+    shown = []
+    for q, pref in (("susp_disp", "susp_disp_3L"), ("axle_acc", "axle_acc_3L"), ("body_acc", "body_acc_3R")):
+        kind = sorted(c for c in rep.fitted if c.startswith(q + "_"))
+        if kind:
+            shown.append(pref if pref in kind else kind[0])
     rows = [(c, rep.fitted[c], "fitted") for c in shown] + [(c, pred[c], "held out") for c in held[:3]]
     fig, axes = plt.subplots(len(rows), 1, figsize=(10, 1.9 * len(rows) + 0.6), sharex=True)
     axes = np.atleast_1d(axes)

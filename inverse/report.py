@@ -12,8 +12,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-#: Table 2 channels in order (axle 3 left/right; acceleration first)
-TABLE2_CHANNELS = ("axle_acc_3L", "axle_acc_3R", "body_acc_3L", "body_acc_3R", "susp_disp_3L", "susp_disp_3R")
+def table2_channels(axle: int = 3) -> tuple:
+    """Table 2 channels in order: one axle, left/right, acceleration first (the paper's axle 3;
+    the reference axle of a drive logged on another, ``inverse.run.reference_axle``)."""
+    return tuple(f"{q}_{axle}{side}" for q in ("axle_acc", "body_acc", "susp_disp") for side in "LR")
+
+
+#: Table 2 channels of the paper (axle 3)
+TABLE2_CHANNELS = table2_channels(3)
 
 
 def table1(segments: list) -> pd.DataFrame:
@@ -122,9 +128,11 @@ def table1_note(fit_quality: dict | None = None, road_model: bool = True, segmen
 def channels_note(channel_set: str, calibrated: bool) -> str:
     """One sentence under Table 1: which channels were fitted and whether the intervals were
     calibrated for them (``inverse.uncertainty.calibration_key``)."""
-    what = {"axle3": "suspension displacement and axle acceleration of axle 3",
-            "axles": "axle accelerations of every axle and the suspension displacement of axle 3",
+    what = {"axles": "axle accelerations of every axle and the suspension displacement of one axle (axle 3 "
+                     "where logged)",
             "all": "every response channel"}.get(channel_set, "a list of the user's")
+    if channel_set.startswith("axle") and channel_set[4:].isdigit():
+        what = f"suspension displacement and axle acceleration of axle {channel_set[4:]}"
     if calibrated:
         return f"Fitted channels: '{channel_set}' ({what}); the intervals are calibrated for them."
     return (f"Fitted channels: '{channel_set}' ({what}); **the intervals use the axle-3 calibration and were "
@@ -147,6 +155,14 @@ TABLE2_NOTE = (
     "Errors are (simulated - measured) / measured in %; rmse_eq6_norm is eq 6's RMSE over the "
     "measured RMS (about 1.4 for two signals of unrelated phase); W1_over_sd is the "
     "Wasserstein-1 distance of the amplitude distributions over the measured sd.")
+
+
+def table2_note(axle: int = 3) -> str:
+    """The note under Table 2; a drive whose Table 2 axle is not the paper's axle 3 says so."""
+    if axle == 3:
+        return TABLE2_NOTE
+    return (f"Channels of axle {axle}, not of axle 3 (the paper's Table 2 axle): not comparable with the "
+            f"paper's table. " + TABLE2_NOTE)
 
 
 def table2(rows: list, spread: dict | None = None) -> pd.DataFrame:
@@ -215,7 +231,7 @@ def write_table(df: pd.DataFrame, stem: Path, floatfmt: str = ".4g", note: str =
 
 
 def write_figures(fig_dir: Path, *, time, measured: dict, simulated: dict | None, segmentation,
-                  seg_signal, title: str = "", which: str = "689") -> list:
+                  seg_signal, title: str = "", which: str = "689", axle: int = 3) -> list:
     """Figures 6, 8 and 9 as PNG and PDF (each drawn once, saved in both formats).
 
     Parameters
@@ -231,6 +247,8 @@ def write_figures(fig_dir: Path, *, time, measured: dict, simulated: dict | None
     which : str
         The figures to draw: any of "6", "8", "9" (Figure 6 needs the fit only, so it can be
         drawn before the realisation is chosen; ``simulated`` may then be None).
+    axle : int
+        The axle whose suspension displacements Figures 8 and 9 show (the run's reference axle).
 
     Returns
     -------
@@ -241,7 +259,7 @@ def write_figures(fig_dir: Path, *, time, measured: dict, simulated: dict | None
 
     fig_dir = Path(fig_dir)
     fig_dir.mkdir(parents=True, exist_ok=True)
-    chans = [c for c in ("susp_disp_3L", "susp_disp_3R") if c in measured and c in (simulated or {})]
+    chans = [c for c in (f"susp_disp_{axle}L", f"susp_disp_{axle}R") if c in measured and c in (simulated or {})]
 
     def both(stem):
         return [fig_dir / f"{stem}.png", fig_dir / f"{stem}.pdf"]
@@ -253,7 +271,7 @@ def write_figures(fig_dir: Path, *, time, measured: dict, simulated: dict | None
         out += both("figure6_segmentation")
     if "8" in which:
         plot_time_compare(time, measured, simulated, chans, both("figure8_time_compare"),
-                          title=f"Figure 8: measured vs simulated, axle 3 {title}\n"
+                          title=f"Figure 8: measured vs simulated, axle {axle} {title}\n"
                                 "simulated on a random-phase road of the fitted spectra: "
                                 "not a phase-true (waveform) comparison")
         out += both("figure8_time_compare")

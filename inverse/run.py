@@ -27,6 +27,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import shutil
 import time as _time
 from pathlib import Path
@@ -37,7 +38,7 @@ from eroad.archive import finish_run_info, run_info, write_json_atomic, write_ru
 from eroad.errors import EroadInputError
 
 __all__ = ["run_inversion", "fit_channels", "axles_channels", "channel_set", "CHANNEL_SETS", "noise_psd_from_sd", "check_out", "headline",
-           "AXLE3_CHANNELS", "RUN_FORMAT"]
+           "AXLE3_CHANNELS", "RUN_FORMAT", "axle_channels", "reference_axle", "paired_axles"]
 
 #: run-folder format version
 RUN_FORMAT = 1
@@ -61,41 +62,86 @@ def noise_psd_from_sd(noise_sd: dict, channels, fs: float, src: str = "--noise")
     return out
 
 
-#: the default fitted channels: both sides of axle 3 (the Table 2 axle)
-AXLE3_CHANNELS = ("susp_disp_3L", "susp_disp_3R", "axle_acc_3L", "axle_acc_3R")
+def axle_channels(axle: int) -> tuple:
+    """The fitted channels of one axle: its suspension displacement and axle acceleration,
+    both sides."""
+    return (f"susp_disp_{axle}L", f"susp_disp_{axle}R", f"axle_acc_{axle}L", f"axle_acc_{axle}R")
 
 
-#: the named channel sets of ``--channels`` besides a comma list
+#: the axle the default inversion fits where the drive logs it: axle 3, the paper's Table 2 axle
+PREFERRED_AXLE = 3
+#: the default fitted channels where axle 3 is logged: both sides of axle 3
+AXLE3_CHANNELS = axle_channels(PREFERRED_AXLE)
+
+
+#: the named channel sets of ``--channels`` besides a comma list ('axle<N>' names any axle)
 CHANNEL_SETS = ("axle3", "axles", "all")
 
 
+def paired_axles(names) -> list:
+    """The axles whose suspension displacement is among ``names`` on both sides, ascending."""
+    got = set(names)
+    found = set()
+    for c in got:
+        m = re.fullmatch(r"susp_disp_(\d+)[LR]", c)
+        if m and {f"susp_disp_{m.group(1)}L", f"susp_disp_{m.group(1)}R"} <= got:
+            found.add(int(m.group(1)))
+    return sorted(found)
+
+
+def reference_axle(names, where: str = "the drive") -> int:
+    """The axle whose two suspension displacements segment the drive and locate the segments
+    on the road: axle 3 (:data:`PREFERRED_AXLE`) where both its sides are among ``names``,
+    else the lowest-numbered axle with both sides (a logger on the front axle only)."""
+    axles = paired_axles(names)
+    if not axles:
+        have = ", ".join(sorted(c for c in names if c.split("_")[0] in ("susp", "axle", "body"))) or "none"
+        raise EroadInputError(f"{where}: the inversion needs the suspension displacement of both sides of one "
+                              f"axle (susp_disp_<a>L and susp_disp_<a>R, e.g. susp_disp_3L and susp_disp_3R); "
+                              f"response channels present: {have}")
+    return PREFERRED_AXLE if PREFERRED_AXLE in axles else axles[0]
+
+
 def axles_channels(available) -> list:
-    """The ``axles`` set: the suspension displacement of axle 3 (both sides) and the axle
-    accelerations of every axle the drive carries (both sides). Every axle sees the same
-    tracks a few metres apart, so their accelerations average the noise and the road's
-    realisation over more stations; the suspension displacements of the other axles are left
-    out because they carry the body's motion, where a vehicle difference (a flexible frame)
-    shows most (results/inverse_blind/20261124-channels-all-axles/)."""
-    return ["susp_disp_3L", "susp_disp_3R"] + sorted(c for c in available if c.startswith("axle_acc_"))
+    """The ``axles`` set: the suspension displacement of the reference axle (axle 3 where
+    logged; :func:`reference_axle`), both sides, and the axle accelerations of every axle the
+    drive carries (both sides). Every axle sees the same tracks a few metres apart, so their
+    accelerations average the noise and the road's realisation over more stations; the
+    suspension displacements of the other axles are left out because they carry the body's
+    motion, where a vehicle difference (a flexible frame) shows most
+    (results/inverse_blind/20261124-channels-all-axles/)."""
+    ref = reference_axle(available)
+    return [f"susp_disp_{ref}L", f"susp_disp_{ref}R"] + sorted(c for c in available if c.startswith("axle_acc_"))
 
 
 def channel_set(names, available) -> str:
-    """The name of a fitted channel list: 'axle3', 'axles', 'all' when it is that set of
-    the drive ``available``, else 'custom' (the key of its uncertainty calibration,
-    :func:`inverse.uncertainty.calibration_key`)."""
+    """The name of a fitted channel list: 'axle<N>' (e.g. 'axle3'), 'axles', 'all' when it is
+    that set of the drive ``available``, else 'custom' (the key of its uncertainty
+    calibration, :func:`inverse.uncertainty.calibration_key`)."""
     got = set(names)
-    for spec in CHANNEL_SETS:
+    resp = [c for c in available if c.split("_")[0] in ("susp", "axle", "body")]
+    for spec in [f"axle{a}" for a in paired_axles(resp)] + ["axles", "all"]:
         if got == set(fit_channels(available, spec)):
             return spec
     return "custom"
 
 
 def fit_channels(available, spec) -> list:
-    """Fitted channels from ``spec`` ('axle3' (default for None), 'axles', 'all' or a comma
-    list / sequence)."""
+    """Fitted channels from ``spec``: None (the default: both sides of the reference axle,
+    :func:`reference_axle`, i.e. axle 3 where logged), 'axle<N>' (axle N's suspension
+    displacement and axle acceleration), 'axles', 'all' or a comma list / sequence. The list
+    always holds one axle's suspension displacement on both sides (the segmentation's)."""
     resp = [c for c in available if c.split("_")[0] in ("susp", "axle", "body")]
-    if spec is None or spec == "axle3":
-        names = [c for c in AXLE3_CHANNELS if c in resp]
+    one = re.fullmatch(r"axle(\d+)", spec) if isinstance(spec, str) else None
+    if spec is None:
+        names = [c for c in axle_channels(reference_axle(resp)) if c in resp]
+    elif one:
+        a = int(one.group(1))
+        if a not in paired_axles(resp):
+            raise EroadInputError(f"--channels {spec}: the drive has no suspension displacement of both sides of "
+                                  f"axle {a} (susp_disp_{a}L, susp_disp_{a}R); axles with both: "
+                                  f"{', '.join(map(str, paired_axles(resp))) or 'none'}")
+        names = [c for c in axle_channels(a) if c in resp]
     elif spec == "axles":
         names = [c for c in axles_channels(resp) if c in resp]
     elif spec == "all":
@@ -106,8 +152,10 @@ def fit_channels(available, spec) -> list:
         if bad:
             raise EroadInputError(f"--channels: {', '.join(bad)} not among the drive's response channels "
                                   f"({', '.join(resp)})")
-    if not {"susp_disp_3L", "susp_disp_3R"} <= set(names):
-        names = ["susp_disp_3L", "susp_disp_3R"] + [c for c in names if not c.startswith("susp_disp_3")]
+    if not paired_axles(names):
+        ref = reference_axle(resp)
+        pair = [f"susp_disp_{ref}L", f"susp_disp_{ref}R"]
+        names = pair + [c for c in names if c not in pair]
     return names
 
 
@@ -120,7 +168,7 @@ def check_out(out: Path, force: bool) -> None:
 
 def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 0, quick: bool = False,
                   force: bool = False, candidates=None, max_iter=None, effects=None, chassis: str = "rigid",
-                  channels="axle3", argv=None, polish: bool = True, noise_sd=None,
+                  channels=None, argv=None, polish: bool = True, noise_sd=None,
                   fit_model: str = "linear", selection: str = "linear", bar=None,
                   road_model: str = "auto", model_form: str = "open") -> dict:
     """Invert a dataset into the run folder ``out`` (see the module docstring).
@@ -191,9 +239,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     """
     from drives.format import read_drive
     from inverse.pipeline import SEED_KEY_FIT, InversionConfig, invert, stream_seed
-    from inverse.realisation import candidate_seeds, select_realisation, select_realisation_linear
-    from inverse.report import (TABLE2_CHANNELS, TABLE2_NOTE, table1, table1_note, table2, write_figures,
-                                write_table)
+    from inverse.realisation import candidate_seeds, select_channels, select_realisation, select_realisation_linear
+    from inverse.report import table1, table1_note, table2, table2_channels, table2_note, write_figures, write_table
     from inverse.uncertainty import overall_fit_quality
     from inverse.sensitivity import FitConfig
     from inverse.spectral import ParamBounds
@@ -213,7 +260,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     from drives.cut import require_moving
     from drives.rate import for_road_methods
     drive, resampled = for_road_methods(drive)   # above the vehicle's solver rate: to 200 Hz
-    drive.require(["susp_disp_3L", "susp_disp_3R"], "eroad invert")
+    from drives.format import CHANNELS_FILE
+    reference_axle(drive.channel_names, f"{drive.path / CHANNELS_FILE}: eroad invert")
     require_moving(drive, "eroad invert")   # the road methods run in distance
     n_cand = int(candidates if candidates is not None else (6 if quick else 16))
     iters = int(max_iter if max_iter is not None else (3 if quick else 12))
@@ -225,6 +273,10 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     time = np.asarray(drive.time, float)
     chans = {c: drive.channels[c].to_numpy(float) for c in fit_channels(drive.channel_names, channels)}
     speed = np.asarray(drive.speed, float)
+    # the axle whose displacements segment the drive and place the segments on the road:
+    # axle 3 where fitted, else the fitted pair (a logger on another axle)
+    ref = reference_axle(list(chans))
+    seg_disp = [f"susp_disp_{ref}L", f"susp_disp_{ref}R"]
     fit_cfg = FitConfig(max_iter=iters, n_workers=1, **({} if polish else {"polish_replicates": 0}))
     bounds = ParamBounds(nmax=(1.0, nmax_cap(SIM_DX)))
     fs = 1.0 / float(np.median(np.diff(time)))
@@ -234,8 +286,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     ckey, calibrated = calibration_key(fit_model, cset)
     icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd,
                            fit_model=fit_model, model_form=model_form, calibration=ckey)
-    make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans))
-    predict = TruckPredictRms(drive.vehicle, ("susp_disp_3L", "susp_disp_3R"), chassis=chassis, effects=effects)
+    make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans), ref_axle=ref)
+    predict = TruckPredictRms(drive.vehicle, tuple(seg_disp), chassis=chassis, effects=effects)
 
     pool = None
     map_fn = map
@@ -251,6 +303,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     try:
         t1 = _time.perf_counter()
         inv = invert(time, chans, speed, make_sim, predict_rms=predict, config=icfg, map_fn=map_fn,
+                     segment_channels=seg_disp,
                      progress=None if bar is None else (lambda entry: bar.update(1)))
         timing["fit_s"] = _time.perf_counter() - t1
         sim = make_sim(inv.t_bounds)
@@ -258,7 +311,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         fit_seed = stream_seed(seed, SEED_KEY_FIT)
         seeds = [fit_seed] + candidate_seeds(seed, n_cand)
         labels = ["fit"] + [f"c{i}" for i in range(n_cand)]
-        table_ch = [c for c in TABLE2_CHANNELS if c in chans]
+        table_ch = [c for c in table2_channels(ref) if c in chans]
+        sel_ch = select_channels(ref)
         sel_map = map_fn
         if bar is not None:
             # linear: the fit's simulation, every candidate's linear response, usually one round of 2
@@ -283,18 +337,19 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                 from inverse.linear_response import LinearRealisation
 
                 sel = select_realisation_linear(sim, LinearRealisation(sim), road_p, chans, seeds,
+                                                channels=sel_ch,
                                                 table_channels=table_ch, map_fn=sel_map, labels=labels,
                                                 per_round=max(1, workers))
             else:
-                sel = select_realisation(sim, road_p, chans, seeds, table_channels=table_ch, map_fn=sel_map,
-                                         labels=labels, sides=False)
+                sel = select_realisation(sim, road_p, chans, seeds, channels=sel_ch,
+                                         table_channels=table_ch, map_fn=sel_map, labels=labels, sides=False)
                 sel.update(method="simulation", n_simulated=len(seeds), fit_simulated=sel.pop("simulated_all")[0])
             timing["selection_s"] = _time.perf_counter() - t
             timing["selection_sims"] = int(sel["n_simulated"])
             if bar is not None:
                 bar.set_description("invert: report")
             fig_kw = dict(time=time, measured=chans, simulated=sel["simulated"], segmentation=inv.segmentation,
-                          seg_signal=chans["susp_disp_3L"], title=f"({drive.name})")
+                          seg_signal=chans[seg_disp[0]], title=f"({drive.name})", axle=ref)
             # Figures 8 and 9 need the chosen realisation: one pool worker each
             figures = ([pool.submit(write_figures, tmp / "figures", which=w, **fig_kw) for w in "89"]
                        if pool is not None else None)
@@ -313,7 +368,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             # Figure 6 needs the fit only: drawn now (in a pool worker: the selection leaves the
             # workers mostly idle, its 3 simulations aside)
             fig6_kw = dict(time=time, measured=chans, simulated=None, segmentation=inv.segmentation,
-                           seg_signal=chans["susp_disp_3L"], title=f"({drive.name})", which="6")
+                           seg_signal=chans[seg_disp[0]], title=f"({drive.name})", which="6", axle=ref)
             fig6 = None
             if pool is None:
                 write_figures(tmp / "figures", **fig6_kw)
@@ -353,8 +408,9 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                 "table2": rows,
                 "errors": headline(rows, sel["spread"]),
                 "selection": {"n_candidates": len(seeds), "selected": sel["label"], "seed": sel["seed"],
-                              "statistic": "sum of w_c ln(rms_sim/rms_meas)^2 over axle_acc_3L/R (w 1) and "
-                                           "susp_disp_3L/R (w 0.25), plus ln(mean_abs ratio)^2 of axle_acc_3L/R",
+                              "statistic": f"sum of w_c ln(rms_sim/rms_meas)^2 over axle_acc_{ref}L/R (w 1) and "
+                                           f"susp_disp_{ref}L/R (w 0.25), plus ln(mean_abs ratio)^2 of "
+                                           f"axle_acc_{ref}L/R",
                               "method": sel["method"], "n_simulated": sel["n_simulated"],
                               "rounds": sel.get("rounds"), "correction": sel.get("correction"),
                               "per_side": bool(sel.get("sides")), "mismatch": sel["mismatch"],
@@ -362,7 +418,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                               "spread": sel["spread"],
                               "candidates": sel["candidates"],
                               "fit_phases_errors": headline(fit_rows)},
-                "fit": {**inv_summary["fit"], "channels": list(chans), "channel_set": cset,
+                "fit": {**inv_summary["fit"], "channels": list(chans), "channel_set": cset, "reference_axle": ref,
                         "uncertainty_calibration": ckey, "uncertainty_calibrated_for_channels": calibrated},
                 "segmentation": inv_summary["segmentation"],
                 "road": {"file": "road.npz", "crg": "road.crg", "seed": sel["seed"], "dx": SIM_DX,
@@ -377,7 +433,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                 basis = (f" Realisations: {sel['n_simulated']} of {len(seeds)} simulated in time, the others the "
                          "linear truck's time response on the same road corrected by the mean log ratio "
                          "simulated / linear of the simulated ones (tables/candidates.csv, column basis).")
-            write_table(table2(rows, sel["spread"]), tmp / "tables" / "table2", note=TABLE2_NOTE + basis)
+            write_table(table2(rows, sel["spread"]), tmp / "tables" / "table2", note=table2_note(ref) + basis)
             import pandas as pd
             pd.DataFrame([{"label": c["label"], "seed": c["seed"], "mismatch": c["mismatch"],
                            "basis": c.get("basis", "simulated"),
