@@ -97,8 +97,8 @@ def fitted_psd(f: dict, n: float) -> float:
     return float(road_psd(n, *segment_spectrum(f)))
 
 
-def reference_axle_x(truth: dict, t) -> np.ndarray:
-    """Road x [m] of the reference axle at record times ``t`` [s].
+def reference_axle_x(truth: dict, t, axle: int | None = None) -> np.ndarray:
+    """Road x [m] of the reference axle (or of ``axle``) at record times ``t`` [s].
 
     Rebuilt from ``truth.json`` exactly as drives.synth.plan_drive lays the drive out:
     PCHIP speed through the speed knots, sampled at the output rate from the run-in's
@@ -113,9 +113,27 @@ def reference_axle_x(truth: dict, t) -> np.ndarray:
     t_rec = k / fs
     v = PchipInterpolator(np.asarray(sp["t_s"], float), np.asarray(sp["v_mps"], float))(t_rec)
     s = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t_rec))])
-    ax = truth["vehicle"]["axle_x_m"][int(rec["reference_axle"]) - 1]
+    ax = truth["vehicle"]["axle_x_m"][int(axle or rec["reference_axle"]) - 1]
     x = float(truth["road"]["x_axle1_at_sim_start_m"]) + ax + s
     return np.interp(np.asarray(t, float), t_rec, x)
+
+
+def on_truth_axle(truth: dict, summary: dict) -> dict:
+    """``summary`` with its segment times moved to the truth's reference axle: a fit on
+    another axle (``fit.reference_axle``, a drive logged on axle 1) places its boundaries
+    where THAT axle crosses them; the truth's are axle 3's, a few tenths of a second later."""
+    a = int(summary.get("fit", {}).get("reference_axle") or truth["record"]["reference_axle"])
+    if a == int(truth["record"]["reference_axle"]):
+        return summary
+    rec = truth["record"]
+    tt = np.arange(-float(rec["runin_s"]), float(rec["duration_s"]) + 1.0, 0.01)
+    x_ref = reference_axle_x(truth, tt)
+    segs = []
+    for f in summary["segments"]:
+        x0, x1 = reference_axle_x(truth, [f["t_start"], f["t_end"]], axle=a)
+        segs.append({**f, "t_start": float(np.interp(x0, x_ref, tt)), "t_end": float(np.interp(x1, x_ref, tt))})
+    segs[0]["t_start"], segs[-1]["t_end"] = summary["segments"][0]["t_start"], summary["segments"][-1]["t_end"]
+    return {**summary, "segments": segs}
 
 
 def window_psd(road, x0: float, x1: float, track_y=REF_TRACK_Y):
@@ -299,6 +317,7 @@ def score_run(ds: Path, scen: str, summ: dict) -> dict:
     from drives.synth import read_truth
 
     truth = read_truth(ds)
+    summ = on_truth_axle(truth, summ)
     if scen == "second_measured":   # no true ISO segment: the driven profile, fitted (measured_truth)
         mtruth = measured_truth(ds, truth)
         case = score_case(mtruth, summ)
