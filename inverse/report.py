@@ -134,7 +134,8 @@ def channels_note(channel_set: str, calibrated: bool) -> str:
     if channel_set.startswith("axle") and channel_set[4:].isdigit():
         what = f"suspension displacement and axle acceleration of axle {channel_set[4:]}"
     if calibrated:
-        return f"Fitted channels: '{channel_set}' ({what}); the intervals are calibrated for them."
+        return (f"Fitted channels: '{channel_set}' ({what}); the intervals are calibrated for them (set or "
+                f"checked on blind drives fitted on these channels).")
     return (f"Fitted channels: '{channel_set}' ({what}); **the intervals use the axle-3 calibration and were "
             f"not checked on blind drives with these channels**.")
 

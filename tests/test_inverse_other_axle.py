@@ -52,10 +52,11 @@ def test_front_axle_drive_is_inverted_on_axle_1_and_finds_axle_3s_road(drive, ca
     out = capsys.readouterr().out
     assert "axle_acc_1L RMS err" in out
     assert s1["fit"]["reference_axle"] == 1 and s1["fit"]["channel_set"] == "axle1"
-    assert not s1["fit"]["uncertainty_calibrated_for_channels"]
+    # axle 1's intervals are the axle-3 constants, checked on blind drives fitted on axle 1
+    assert s1["fit"]["uncertainty_calibration"] == "linear/axle1" and s1["fit"]["uncertainty_calibrated_for_channels"]
     assert [r["channel"] for r in s1["table2"]][0] == "axle_acc_1L"
     note = (root / "inv1" / "tables" / "table1.md").read_text()
-    assert "axle 1" in note and "not checked on blind drives" in note
+    assert "axle 1" in note and "calibrated for them" in note
     assert "not comparable" in (root / "inv1" / "tables" / "table2.md").read_text()
     assert s3["fit"]["reference_axle"] == 3 and s3["fit"]["uncertainty_calibrated_for_channels"]
     # The two axles drove the same road 5 m apart, and their models differ (axle 1 steered, lighter
@@ -70,6 +71,13 @@ def test_front_axle_drive_is_inverted_on_axle_1_and_finds_axle_3s_road(drive, ca
     def lnG(seg):
         return math.log(seg["Gq_n0"] * (n / 0.1) ** (-seg["w"]))
     assert abs(lnG(a) - lnG(b)) <= 0.3, (lnG(a), lnG(b))
+
+
+def test_an_unchecked_axle_says_its_intervals_were_not_checked(drive):
+    root, full = drive
+    s2 = _invert(_keep_axles(full, root / "axle2", [2]), root / "inv2")
+    assert s2["fit"]["channel_set"] == "axle2" and not s2["fit"]["uncertainty_calibrated_for_channels"]
+    assert "not checked on blind drives" in (root / "inv2" / "tables" / "table1.md").read_text()
 
 
 def test_one_side_only_is_refused_with_one_line(drive, capsys):
