@@ -253,8 +253,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     for name, v, lo in (("--workers", workers, 1), ("--seed", seed, 0)):
         if not isinstance(v, int) or v < lo:
             raise EroadInputError(f"{name} must be an integer >= {lo}, got {v!r}")
-    if segments is not None and not (isinstance(segments, int) and 1 <= segments <= 12):
-        raise EroadInputError(f"--segments must be an integer in 1..12, got {segments!r}")
+    if segments is not None and not (isinstance(segments, int) and segments >= 1):
+        raise EroadInputError(f"--segments must be an integer >= 1, got {segments!r}")
     check_out(out, force)
     drive = read_drive(dataset)
     from drives.cut import require_moving

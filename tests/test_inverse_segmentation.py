@@ -94,3 +94,55 @@ def test_speed_change_on_one_road_is_not_a_road_change():
         k_raw.append(segment(d.time, ch, d.speed, speed_exponent=0).n_segments)
     assert k_corr == [1] * 6, k_corr
     assert sum(k > 1 for k in k_raw) >= 2, k_raw
+
+
+# ----------------------------------------------------------------------------- long drives
+# A drive of several minutes holds more than the 8 segments a 30 s drive was capped at: before
+# 2026-11-27 a 300 s drive over 21 road pieces came out as 8 segments, four of them 'poor', and
+# --segments refused anything above 12.
+
+def test_penalised_partition_is_the_dp_choice_of_k():
+    """PELT's optimum over every K equals the dynamic programme's table for K = 1..n/min_len
+    followed by the choice of K with the same per-piece penalty (exact; ties aside)."""
+    from inverse.segmentation import _backtrack, _partition_all, _piece_cost, penalised_partition
+
+    rng = np.random.default_rng(11)
+    for _ in range(40):
+        n, m = int(rng.integers(30, 160)), int(rng.integers(1, 6))
+        edges = np.unique(np.r_[0, rng.integers(1, n, int(rng.integers(0, 6))), n])
+        scale = np.concatenate([np.full(b - a, np.exp(rng.normal())) for a, b in zip(edges[:-1], edges[1:])])
+        y = scale * rng.chisquare(4, n) / 4
+        beta = float(rng.uniform(0.5, 20.0))
+        back, final = _partition_all(y, n // m, m, "variance")
+        crit = final + beta * np.arange(1, n // m + 1)
+        kb = int(np.argmin(crit)) + 1
+        got = penalised_partition(y, beta, m, "variance")
+        cost = _piece_cost(y, "variance")
+        assert np.sum(cost(got[:-1], got[1:])) + beta * (got.size - 1) == pytest.approx(crit[kb - 1], rel=1e-10)
+        assert np.all(np.diff(got) >= m)
+        assert got.size - 1 == kb and np.array_equal(got, _backtrack(back, kb, n))
+
+
+def test_a_300_s_drive_of_20_pieces_is_cut_into_20():
+    """20 pieces of 8-22 s (neighbours one to five ISO classes apart) on the quarter truck:
+    K = 20 and every boundary within 0.5 s (measured over seeds 0-3: K = 20, at most 0.46 s),
+    in well under a second of segmentation."""
+    rng = np.random.default_rng(0)
+    lv = [0]
+    for _ in range(19):
+        lv.append(int(rng.choice([x for x in range(-2, 4) if x != lv[-1]])))
+    P = np.array([[256e-6 * 4.0 ** v, 2.0, 0.05, 5.0] for v in lv])
+    d = make_drive(P, list(rng.uniform(8, 22, 20)), speed=lambda t: 10 + 1.5 * np.sin(2 * np.pi * t / 30), seed=0)
+    r = segment(d.time, {c: d.channels[c] for c in DISP}, d.speed)
+    assert r.n_segments == 20
+    assert max(np.min(np.abs(r.t_bounds - b)) for b in d.t_bounds[1:-1]) < 0.5
+    # the old cap is still there when asked for
+    assert segment(d.time, {c: d.channels[c] for c in DISP}, d.speed, k_max=8).n_segments == 8
+
+
+def test_more_segments_than_the_drive_holds_is_one_clear_error():
+    from eroad.errors import EroadInputError
+
+    d = _three_segment_drive()
+    with pytest.raises(EroadInputError, match=r"--segments 100: a drive of 30\.0 s holds at most 60 segments"):
+        segment(d.time, d.channels["susp_disp_3L"], d.speed, k=100)
