@@ -146,3 +146,28 @@ def test_more_segments_than_the_drive_holds_is_one_clear_error():
     d = _three_segment_drive()
     with pytest.raises(EroadInputError, match=r"--segments 100: a drive of 30\.0 s holds at most 60 segments"):
         segment(d.time, d.channels["susp_disp_3L"], d.speed, k=100)
+
+
+def test_penalised_partition_equals_optimal_partitioning_without_pruning():
+    """The pruning is exact with a shortest piece: PELT against plain optimal partitioning
+    (F(t) = min over tau of F(tau) + C(tau, t) + beta, every tau kept) on 600 short series of
+    heavy-tailed mean squares (chi-square 2) with shortest pieces of 2-7 samples. Pruning a
+    candidate as soon as it is found worse, before a shortest piece has passed, loses the
+    optimum in about 1 % of such series (measured: 35 of 3000)."""
+    from inverse.segmentation import _piece_cost, penalised_partition
+
+    for seed in range(600):
+        rng = np.random.default_rng(seed)
+        n, m = int(rng.integers(20, 80)), int(rng.integers(2, 8))
+        edges = np.unique(np.r_[0, rng.integers(1, n, int(rng.integers(0, 8))), n])
+        scale = np.concatenate([np.full(b - a, np.exp(rng.normal(0, 1.5))) for a, b in zip(edges[:-1], edges[1:])])
+        y = scale * rng.chisquare(2, n) / 2
+        beta = float(rng.uniform(0.1, 10.0))
+        cost = _piece_cost(y, "variance")
+        F = np.full(n + 1, np.inf)
+        F[0] = -beta
+        for t in range(m, n + 1):
+            tau = np.arange(0, t - m + 1)
+            F[t] = np.min(F[tau] + cost(tau, t) + beta)
+        got = penalised_partition(y, beta, m, "variance")
+        assert np.sum(cost(got[:-1], got[1:])) + beta * (got.size - 2) == pytest.approx(F[n], rel=1e-12, abs=1e-9), seed
