@@ -83,16 +83,23 @@ def effects_from_diagnosis(summary: dict, action: str = "inverted") -> tuple[dic
 CHANNELS_WHEN_NONE = "axles"
 
 
-def loop_channels(verdict: str | None, channels=None) -> tuple:
+def loop_channels(verdict: str | None, channels=None, available=None) -> tuple:
     """The fitted channels of a closed loop's inversions and the phrase that says why.
 
     ``channels`` given by the caller are kept (the phrase is empty); None: ``axles``
     (:data:`CHANNELS_WHEN_NONE`) where the verdict is ``none``, else None: the inversion's
     default, axle 3 (or the reference axle of a drive logged elsewhere, ``inverse.run.reference_axle``).
+    ``available`` (the drive's channel names): where ``axles`` holds no more than the default
+    (a drive logged on one axle), the default is kept and the phrase says so.
     """
     if channels is not None:
         return channels, ""
     if verdict == "none":
+        if available is not None:
+            from inverse.run import fit_channels
+            if set(fit_channels(available, CHANNELS_WHEN_NONE)) == set(fit_channels(available, None)):
+                return None, ("no gap beyond noise; the drive logs one axle's accelerations, so its default "
+                              "channels are fitted")
         return CHANNELS_WHEN_NONE, ("no gap beyond noise, so the accelerations of every axle are fitted "
                                     "(channel set 'axles')")
     return None, ""
@@ -203,7 +210,9 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     try:
         dsum = _diagnosis_summary(dataset, work, diagnosis, True, workers, quick, seed, progress, out)
         effects, reason = effects_from_diagnosis(dsum)
-        inversion["channels"], why = loop_channels(dsum.get("verdict"), inversion.get("channels"))
+        from drives.format import read_drive
+        inversion["channels"], why = loop_channels(dsum.get("verdict"), inversion.get("channels"),
+                                                   read_drive(dataset).channel_names)
         reason = f"{reason}; {why}" if why else reason
         progress(f"closed loop: {reason}")
         progress("closed loop: nominal inversion ...")

@@ -94,6 +94,18 @@ def test_channels_follow_the_verdict_unless_given(verdict, given, expect):
     assert bool(why) == (given is None and verdict == "none")
 
 
+def test_a_one_axle_drive_keeps_its_default_channels_and_says_why():
+    """'axles' on a drive logged on one axle is that axle's default set: the loop keeps the
+    default (and its calibration key) and does not claim to fit every axle."""
+    from diagnosis.closed_loop import loop_channels
+
+    front = ["susp_disp_1L", "susp_disp_1R", "axle_acc_1L", "axle_acc_1R", "body_acc_1L", "speed"]
+    chans, why = loop_channels("none", None, front)
+    assert chans is None and "one axle" in why and "every axle" not in why
+    truck = [f"{q}_{a}{s}" for q in ("susp_disp", "axle_acc") for a in range(1, 5) for s in "LR"]
+    assert loop_channels("none", None, truck)[0] == "axles"
+
+
 def test_a_none_verdict_fits_every_axle_with_its_own_calibration(tmp_path):
     """A diagnosis answering 'none' (given): the nominal inversion fits the 'axles' set, records
     it and the calibration it used, and says so in the reason."""
