@@ -622,12 +622,17 @@ def windows(sig: Signals, n_windows: int = 4):
 
 def segment_axle(names) -> int:
     """The axle whose suspension displacements segment the record (the reference axle of
-    :class:`TruckModel`): axle 3 where logged, else the lowest-numbered axle logged on both
-    sides (``inverse.run.reference_axle``), else the lowest-numbered one logged at all."""
-    from inverse.run import PREFERRED_AXLE, paired_axles
+    :class:`TruckModel`): the inversion's (``inverse.run.reference_axle``: axle 3 where logged,
+    else the lowest-numbered axle logged on both sides), else, for a record with one side only,
+    the lowest-numbered axle with a displacement at all."""
+    from inverse.run import PREFERRED_AXLE, reference_axle
 
-    axles = paired_axles(names) or sorted({int(c[len("susp_disp_"):-1]) for c in names
-                                           if c.startswith("susp_disp_") and c[len("susp_disp_"):-1].isdigit()})
+    try:
+        return reference_axle(names)
+    except EroadInputError:
+        pass
+    axles = sorted({int(c[len("susp_disp_"):-1]) for c in names
+                    if c.startswith("susp_disp_") and c[len("susp_disp_"):-1].isdigit()})
     if not axles:
         raise EroadInputError("diagnosis: no suspension displacement channel (susp_disp_*) to segment the road on")
     return PREFERRED_AXLE if PREFERRED_AXLE in axles else axles[0]

@@ -58,9 +58,15 @@ def candidate_seeds(root: int, m: int) -> list:
 SELECT_WEIGHT_DISP = 0.25
 
 
+def channel_weight(channel: str) -> float:
+    """The selection statistic's weight of one channel: :data:`SELECT_WEIGHT_DISP` for a
+    suspension displacement, 1 otherwise."""
+    return SELECT_WEIGHT_DISP if channel.startswith("susp_disp_") else 1.0
+
+
 def select_weights(axle: int = 3) -> dict:
     """Channel -> weight of the selection statistic for :func:`select_channels` ``(axle)``."""
-    return {c: (SELECT_WEIGHT_DISP if c.startswith("susp_disp_") else 1.0) for c in select_channels(axle)}
+    return {c: channel_weight(c) for c in select_channels(axle)}
 
 
 #: the weights of axle 3's statistic
@@ -107,7 +113,7 @@ def mismatch_stats(measured: dict, simulated: dict, channels=SELECT_CHANNELS, us
         term = math.log(s["rms"] / m["rms"]) ** 2
         if use_mean_abs and "_acc_" in c:
             term += math.log(s["mean_abs"] / m["mean_abs"]) ** 2
-        w = weights.get(c, 1.0) if weights is not None else (SELECT_WEIGHT_DISP if c.startswith("susp_disp_") else 1.0)
+        w = weights.get(c, 1.0) if weights is not None else channel_weight(c)
         total += w * term
     return float(total)
 
