@@ -28,6 +28,32 @@ def test_calibrate_finds_the_minimum():
     assert np.log10(cal.effects["e"]["b"]) == pytest.approx(1.3, abs=0.1)
 
 
+def test_calibrate_refines_the_second_basin_of_a_two_basin_grid(monkeypatch):
+    """An objective with two basins, as a damper asymmetry's (rebound- or compression-heavy
+    fit the band powers alike): a basin at the lower edge (value 0.2145 at u = 0, the grid's
+    best point) and a deeper one at u = 0.85 (0.205) between the last two grid points of a
+    4-point grid (0.2218 at 2/3, 0.2162 at 1).  The values are shaped on blind case 005's
+    second fold (0.2145, 0.3275, 0.2291, 0.2239 on the grid) (results/diagnosis_blind/20261127-fresh-40; damper ratio 0.3 ... 6, log).
+    Refining only the grid's best point stays at the edge; refining every grid basin finds
+    the deeper one within the golden bracket's tolerance (2/3 * 0.618^2 = 0.25 after 3
+    evaluations; 0.85 +- 0.15 asked)."""
+    import diagnosis.which as which
+
+    def obj(e):
+        u = e["e"]["a"]
+        return min(0.2145 + 0.3 * u, 0.205 + 0.5 * (u - 0.85) ** 2 + (0.3 if u < 0.55 else 0.0))
+
+    c = Candidate("e", (Param("a", 0.0, 1.0),))
+    vals = [obj({"e": {"a": u}}) for u in np.linspace(0, 1, 4)]
+    assert int(np.argmin(vals)) == 0                   # the grid's best is the edge basin
+    cal = calibrate([c], obj, grid=4, refine=3)
+    assert cal.effects["e"]["a"] == pytest.approx(0.85, abs=0.15)
+    assert cal.calib_gap < 0.2145
+    assert cal.n_evals <= 4 + 3 + 3
+    monkeypatch.setattr(which, "BASINS", 1)            # the old search: best grid point only
+    assert calibrate([c], obj, grid=4, refine=3).effects["e"]["a"] < 0.34
+
+
 def test_candidates_from_library_reads_an_effect_registry():
     """Duck-typed registry (objects with .parameters of name/default/range): up to two
     calibrated parameters, log search for wide positive ranges, the rest fixed at defaults."""
