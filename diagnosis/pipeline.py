@@ -489,7 +489,9 @@ def relevel(sim: dict, g) -> dict:
     and low-frequency power the measurement does not have, so the true payload model
     scored worse than the nominal one (blind case 006 of results/diagnosis_blind/
     20261127-fresh-40, second fold: held-out gap 1.90 against the nominal model's
-    0.51; 0.40 with the offset kept).
+    0.51; 0.40 with the offset kept).  The window mean stands for the static state: the
+    motion's own mean over a 7.5 s window (about 1 mm) is kept unscaled, so pieces with
+    factors 0.5 and 1.5 differ by about 0.5 mm where the whole-signal scaling put 23 mm.
     """
     g = np.asarray(g, float)
     out = {}

@@ -46,3 +46,64 @@ def test_relevel_with_a_constant_factor_is_a_scaling_about_the_mean():
     out = relevel({"c": x}, 2.0)["c"]
     assert np.allclose(out, x.mean() + 2.0 * (x - x.mean()))
     assert out.mean() == pytest.approx(x.mean())
+
+
+def _motion(rng, n):
+    """Unit-variance motion below 4 Hz (a suspension's band; nothing at the top of the band,
+    where the re-levelling estimates a white noise floor)."""
+    from scipy import signal
+
+    x = signal.sosfiltfilt(signal.butter(4, 4.0, fs=200.0, output="sos"), rng.standard_normal(n))
+    return x / x.std()
+
+
+class _OffsetModel:
+    """A stand-in for pipeline.TruckModel: its 'simulation' of a window is a static offset
+    (a payload change) plus 8 mm rms of Gaussian motion; two road pieces of 5 s."""
+
+    fs = 200.0
+    channels = ["susp_disp_3L"]
+    noise = {"susp_disp_3L": 0.0}
+    gq = np.array([1.0, 1.0])
+    bounds = np.array([0.0, 5.0, 10.0])
+    offset = -0.023
+
+    def run(self, effects, t0, t1, seed, gq=None):
+        n = int(round((t1 - t0) * self.fs))
+        return {"susp_disp_3L": self.offset + 0.008 * _motion(np.random.default_rng(seed), n)}
+
+    def pieces(self, t0, t1):
+        from diagnosis.pipeline import TruckModel
+        return TruckModel.pieces(self, t0, t1)
+
+    def add_noise(self, chans, seed, noise=None):
+        return dict(chans)
+
+
+def test_the_simulate_callable_keeps_the_static_offset_through_the_re_levelling(monkeypatch):
+    """The wiring: ``pipeline.Simulate`` re-levels each road piece to the measured window by
+    its own factor (measured 4 and 12 mm rms below 4 Hz against 8 mm simulated: factors of
+    about 0.5 and 1.5) and must keep the offset in both pieces (the old ``x * g`` left about
+    -11.5 and -34.5 mm: a 23 mm step between the pieces)."""
+    import diagnosis.pipeline as pl
+    from diagnosis.pipeline import Simulate, State
+    from diagnosis.signals import Signals
+
+    monkeypatch.setattr(pl, "TILT_REFIT", False)
+    m = _OffsetModel()
+    rng = np.random.default_rng(7)
+    n = 2000
+    x = _motion(rng, n)
+    meas = np.concatenate([0.004 * x[: n // 2], 0.012 * x[n // 2:]])
+    w = Signals(np.arange(n) / m.fs, {"susp_disp_3L": m.offset + meas}, meta={"t0": 0.0})
+    out = Simulate(m)(State({}), w, 5).channels["susp_disp_3L"]
+    a, b = out[: n // 2 - 60], out[n // 2 + 60:]          # outside the 0.5 s ramp
+    assert a.std() == pytest.approx(0.004, rel=0.1)        # each piece re-levelled
+    assert b.std() == pytest.approx(0.012, rel=0.1)
+    # the offset kept in both pieces, within the sampling error of a piece's mean (a motion
+    # below 4 Hz has about 40 independent samples per 4.7 s piece: 4 / sqrt(40) = 0.6 mm
+    # and 12 / sqrt(40) = 1.9 mm; plus the window mean's motion left unscaled, 8 / sqrt(80)
+    # x 0.5 = 0.45 mm): 2 and 4 mm
+    assert a.mean() == pytest.approx(m.offset, abs=2e-3)
+    assert b.mean() == pytest.approx(m.offset, abs=4e-3)
+    assert abs(a.mean() - b.mean()) < 6e-3                # x * g: about 23 mm
