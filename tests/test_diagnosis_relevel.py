@@ -107,3 +107,29 @@ def test_the_simulate_callable_keeps_the_static_offset_through_the_re_levelling(
     assert a.mean() == pytest.approx(m.offset, abs=2e-3)
     assert b.mean() == pytest.approx(m.offset, abs=4e-3)
     assert abs(a.mean() - b.mean()) < 6e-3                # x * g: about 23 mm
+
+
+def test_the_gap_terms_do_not_see_a_displacement_sensor_zero():
+    """A logger's displacement zero is arbitrary (the measurement contract fixes no static
+    reference), so a constant offset on the measured suspension displacements must not move
+    the band gap or the skewness term: both remove the mean (per Welch segment; per window).
+    End to end the same holds (checked 2026-11-27 on blind case 000 of
+    results/diagnosis_blind/20261127-fresh-40 with +-12 mm on every displacement: `eroad
+    invert` gave the same classes and errors, `eroad diagnose --quick` the same verdict and
+    gaps to the printed digit)."""
+    from diagnosis.gap import band_gap, reference
+    from diagnosis.signals import Signals
+    from diagnosis.which import ShapeTerm
+
+    rng = np.random.default_rng(11)
+    n = 1500
+    chans = ["susp_disp_3L", "susp_disp_3R"]
+    meas = Signals(np.arange(n) / 200.0, {c: 0.008 * _motion(rng, n) for c in chans}, meta={"t0": 0.0})
+    shifted = Signals(meas.time, {c: x + (0.012 if c.endswith("L") else -0.012)
+                                  for c, x in meas.channels.items()}, meta={"t0": 0.0})
+    sim = Signals(meas.time, {c: 0.009 * _motion(rng, n) for c in chans}, meta={"t0": 0.0})
+    g0 = band_gap([sim], reference([meas], chans)).value
+    g1 = band_gap([sim], reference([shifted], chans)).value
+    assert g1 == pytest.approx(g0, rel=1e-9)
+    term = ShapeTerm(channels=chans)
+    assert np.allclose(term.stats([meas]), term.stats([shifted]), atol=1e-9)
