@@ -598,8 +598,9 @@ class Simulate:
                 sim = apply_tilt(sim, m.fs, dw)
             for _ in range(2):
                 g = level_scale(m, w.channels, sim, t0, t1, noise=noise)
-                noise = window_noise(w.channels, relevel(sim, g), m.fs)
-            sim = relevel(sim, g)
+                levelled = relevel(sim, g)
+                noise = window_noise(w.channels, levelled, m.fs)
+            sim = levelled
         sim = m.add_noise(sim, seed, noise)
         return Signals(w.time, sim, dict(w.units), w.speed, {"model": "truck", **state.effects})
 
