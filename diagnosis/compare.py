@@ -41,6 +41,10 @@ mix model and road errors.  Ratios between channels of one record cancel the roa
   Kolmogorov's distribution rescaled for standardised samples
   (``KS_STANDARDISED_SCALE``, Monte Carlo).  Under
   heavy-tailed data these variances are too small: treat flags as indicative.
+* :func:`stroke_velocity_skewness` - the skewness of the suspension stroke velocity,
+  averaged over the wheel stations: 0 for a linear truck on a Gaussian road whatever the
+  road spectrum, the signature of a damper whose rebound and compression differ
+  (the verdict's own signature of ``damper_asymmetry``, ``diagnosis.verdict``).
 
 Time-history metrics (:func:`sprague_geers`, :func:`russell`) compare two signals
 sample by sample.  Use them ONLY where the road under the wheels is known or
@@ -1114,6 +1118,46 @@ def distribution_shape(measured, simulated, *, channels: Sequence[str] | None = 
 
 
 # ----------------------------------------------------------------------------- time-history metrics
+#: band of the suspension stroke velocity whose skewness is the damper-asymmetry signature
+#: [Hz]: from below the body bounce to above the wheel hop (10-12 Hz for this truck), where
+#: the damper works; above it a 0.1 mm displacement noise, differentiated, would dominate
+STROKE_VELOCITY_BAND = (0.5, 15.0)
+
+
+def stroke_velocity_skewness(signals, band: tuple[float, float] = STROKE_VELOCITY_BAND,
+                             quantity: str = "susp_disp") -> float | None:
+    """Skewness of the suspension stroke velocity, averaged over the wheel stations.
+
+    Each ``susp_disp_*`` channel is band-passed (``band``, fourth-order Butterworth, zero
+    phase) and differentiated; the skewness ``E[v^3] / E[v^2]^1.5`` of each station's velocity
+    is averaged over the stations.  Why this statistic: a linear truck on a Gaussian road has
+    Gaussian stroke velocities (skewness 0 whatever the road spectrum, speed or the truck's
+    stiffnesses), and a displacement sensor's offset or a gain drops out.  A damper whose
+    rebound and compression coefficients differ makes the velocity distribution lopsided
+    (the stiffer direction is the slower one), so the sign and size of this number follow the
+    asymmetry ratio; symmetric nonlinearities (Coulomb friction) leave it near 0.  Measured
+    (development drives, our truck, 30 s): nominal model -0.16..+0.18 per station,
+    station mean within +-0.05 over road phases; a damper asymmetry 2.94 gave +0.24..+0.53
+    per station (mean +0.35).  None where the record has no such channel.
+    """
+    from scipy.signal import butter, sosfiltfilt
+
+    sig = as_signals(signals)
+    names = sorted(c for c in sig.channels if c.startswith(quantity + "_"))
+    if not names:
+        return None
+    hi = min(float(band[1]), 0.45 * sig.fs)
+    sos = butter(4, [float(band[0]), hi], btype="band", fs=sig.fs, output="sos")
+    out = []
+    for c in names:
+        v = np.gradient(sosfiltfilt(sos, np.asarray(sig.channels[c], float)), 1.0 / sig.fs)
+        v = v - v.mean()
+        m2 = float(np.mean(v ** 2))
+        if m2 > 0:
+            out.append(float(np.mean(v ** 3)) / m2 ** 1.5)
+    return float(np.mean(out)) if out else None
+
+
 def sprague_geers(measured: np.ndarray, computed: np.ndarray) -> tuple[float, float, float]:
     """Sprague-Geers magnitude, phase and combined errors (Sprague and Geers 2004).
 

@@ -65,7 +65,7 @@ def jsonable(obj: Any) -> Any:
 def build_summary(localization=None, *, transmissibility=None, front_rear=None, shape=None,
                   ranking=None, meta: Mapping | None = None, signature=None,
                   transmissibility_two_input=None, signature_two_input=None,
-                  signature_rival=None) -> dict:
+                  signature_rival=None, signature_own=None) -> dict:
     """Machine-readable summary of a diagnosis.
 
     Parameters
@@ -86,6 +86,9 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
         ``{"effect", "single_input", "two_input"}`` (Signatures or None): the same for the
         rival that came within noise of the winner's gap (``pipeline.close_rival``); the
         verdict breaks such a tie on it.
+    signature_own : dict, optional
+        :func:`diagnosis.verdict.own_signature` record of a winner the transmissibility
+        cannot test (damper asymmetry): the verdict tests it on this instead.
 
     The verdict is :func:`diagnosis.verdict.decide` on this summary (the ranking's own
     decision is kept under ``ranking_decision``).
@@ -160,6 +163,8 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
             s["signature"] = signature.record()
         if signature_two_input is not None:
             s["signature_two_input"] = signature_two_input.record()
+        if signature_own is not None:
+            s["signature_own"] = dict(signature_own)
         if signature_rival is not None:
             s["signature_rival"] = {
                 "effect": signature_rival["effect"],
@@ -453,6 +458,18 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                      + (f"; still off: {', '.join(S['pairs_off'])}" if S.get("pairs_off") else "")
                      + ("; the verdict uses this one" if tag == used else "; not used by the verdict")
                      + ".")
+        O = D.get("signature_own")
+        if O and O.get("agrees") is not None:
+            L.append(f" Its own signature, the stroke-velocity skewness (mean over the wheel "
+                     f"stations; 0 for a linear truck on a Gaussian road; sd over road phases "
+                     f"{O['sd']:.2g}): measured {O['measured']:+.2f}, nominal model "
+                     f"{O['nominal_mean']:+.2f} (z {O['z_nominal']:+.1f}), with "
+                     f"{R['model'] if R['model'] != 'nominal' else 'the effect'} "
+                     f"{O['model_mean']:+.2f} (z {O['z_model']:+.1f}); "
+                     + ("it singles the effect out; the verdict uses it instead of the "
+                        "transmissibility." if O["agrees"] else
+                        "it does not single the effect out; the verdict uses it instead of the "
+                        "transmissibility."))
         if D.get("edge"):
             L.append(f" Calibrated at the edge of the search range: {', '.join(D['edge'])}.")
         L.append("")
@@ -619,7 +636,7 @@ def _terms_text(settings: Mapping) -> str:
 def write_report(out: str | os.PathLike, *, localization=None, transmissibility=None,
                  front_rear=None, shape=None, ranking=None, meta: Mapping | None = None,
                  force: bool = False, signature=None, transmissibility_two_input=None,
-                 signature_two_input=None, signature_rival=None) -> Path:
+                 signature_two_input=None, signature_rival=None, signature_own=None) -> Path:
     """Write ``summary.json``, ``figures/*.png`` and ``report.md`` into ``out``.
 
     Parameters
@@ -627,7 +644,7 @@ def write_report(out: str | os.PathLike, *, localization=None, transmissibility=
     out : path
         Run folder; refused if it exists and is not empty unless ``force``.
     localization, transmissibility, front_rear, shape, ranking, meta, signature,
-    transmissibility_two_input, signature_two_input, signature_rival
+    transmissibility_two_input, signature_two_input, signature_rival, signature_own
         As for :func:`build_summary`.
     force : bool
         Replace an existing non-empty ``out`` (only after the new one is complete).
@@ -644,7 +661,7 @@ def write_report(out: str | os.PathLike, *, localization=None, transmissibility=
                             shape=shape, ranking=ranking, meta=meta, signature=signature,
                             transmissibility_two_input=transmissibility_two_input,
                             signature_two_input=signature_two_input,
-                            signature_rival=signature_rival)
+                            signature_rival=signature_rival, signature_own=signature_own)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
     try:
