@@ -439,6 +439,8 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                      + ", ".join(f"{b['band_centre_hz']:.3g} Hz ({b['gap']:.3g} against "
                                  f"{b['sampling_floor']:.3g})" for b in R["bands_left"]) + ".")
         used = D.get("signature_method")
+        if (D.get("signature_own") or {}).get("agrees") is not None:
+            used = None         # the effect is tested on its own signature (below)
         for key, what in (("signature_two_input", "Two-input axle-to-body transmissibility "
                                                   "(body on both axles of its station)"),
                           ("signature", "Axle-to-body transmissibility (single input)")):
@@ -456,7 +458,9 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                      + (f", {S['n_unresolved']} cells not resolved (inputs too coherent)"
                         if S.get("n_unresolved") else "")
                      + (f"; still off: {', '.join(S['pairs_off'])}" if S.get("pairs_off") else "")
-                     + ("; the verdict uses this one" if tag == used else "; not used by the verdict")
+                     + ("; the verdict uses this one" if tag == used else
+                        "; not used by the verdict" + ("" if used else
+                                                       " (it tests this effect on its own signature)"))
                      + ".")
         O = D.get("signature_own")
         if O and O.get("agrees") is not None:

@@ -151,12 +151,16 @@ def test_own_signature_names_a_damper_the_transmissibility_cannot_test():
     assert decide(_summary(own=own), own=False)["verdict"] == "unexplained"
 
 
-@pytest.mark.parametrize("measured, why", [
-    (0.01, "the measurement shows no asymmetry"),               # nominal within noise
-    (0.80, "the candidate falls short of it"),                  # |z_model| > 2
+WEAK = [0.05, 0.02, 0.06, 0.01, 0.01]          # a nearly symmetric damper: mean 0.03
+
+
+@pytest.mark.parametrize("measured, model, why", [
+    (0.01, DAMP, "the measurement shows no asymmetry"),          # nominal within noise
+    (0.80, DAMP, "the candidate falls short of it"),             # |z_model| > 3
+    (0.03, WEAK, "a candidate matching a measurement the nominal model makes too"),
 ])
-def test_own_signature_withholds_a_name_the_transmissibility_would_give(measured, why):
-    own = own_signature("damper_asymmetry", measured, NOM, DAMP)
+def test_own_signature_withholds_a_name_the_transmissibility_would_give(measured, model, why):
+    own = own_signature("damper_asymmetry", measured, NOM, model)
     r = own_signature_agrees(own)
     assert not r["agrees"], why
     assert abs(r["z_nominal"]) < OWN_Z_NOMINAL or abs(r["z_model"]) > OWN_Z_MODEL
@@ -183,9 +187,13 @@ class _Entry:
 
 class _StandInModel:
     """Runs the one-mass oscillator: symmetric without effects, rebound-heavy with them;
-    a different base motion per road seed."""
+    a different base motion per road seed.  Logs what it was asked to run."""
+
+    def __init__(self):
+        self.calls = []
 
     def run(self, effects, t0, t1, seed):
+        self.calls.append((bool(effects), seed))
         ratio = effects["damper_asymmetry"]["ratio"] if effects else 1.0
         s = _oscillator_stroke(ratio, T=120.0, seed=seed)
         return {"susp_disp_1L": s}
@@ -199,12 +207,16 @@ def test_pipeline_records_nominal_and_candidate_on_the_same_road_phases():
     # 115 s records: ratio 3 gave -0.16..-0.06 over base-motion seeds 1-15 (sd 0.03); the
     # measurement is seed 99's, the records those of seeds 1-5 (the signature's phases)
     meas = _signals({"susp_disp_1L": _oscillator_stroke(3.0, T=120.0, seed=99)})
-    rec, dt = own_signature_record(_StandInModel(), meas,
+    model = _StandInModel()
+    rec, dt = own_signature_record(model, meas,
                                    _Entry("damper_asymmetry", {"damper_asymmetry": {"ratio": 3.0}}),
                                    seed=0)
     assert rec["effect"] == "damper_asymmetry" and dt >= 0
     assert len(rec["nominal"]) == len(rec["model"]) == 5
     assert abs(np.mean(rec["nominal"])) < 0.06 and np.mean(rec["model"]) < -0.08
+    # paired: both models on the signature's road phases seed + 1 .. seed + 5
+    assert sorted(sd for eff, sd in model.calls if not eff) == [1, 2, 3, 4, 5]
+    assert sorted(sd for eff, sd in model.calls if eff) == [1, 2, 3, 4, 5]
     r = own_signature_agrees(rec)
     assert r["agrees"] is True and r["z_nominal"] < -OWN_Z_NOMINAL
     # effects without an own signature get none
