@@ -135,8 +135,16 @@ CALIBRATIONS = {
 # fitted on axle 1's four channels (results/inverse_blind/20261127-axle1-logger/): segments >= 3 s
 # covered 91 / 92 / 88 % (null), 95 / 97 / 92 % (friction, open loop), 95 / 95 / 88 % (the
 # independent truck) for ln Gq(n0) / w / ln G(n_best); axle 3 on the same drives 94 / 92 / 94,
-# 91 / 97 / 94, 98 / 97 / 100 %. Other single axles (2, 4) were not checked.
+# 91 / 97 / 94, 98 / 97 / 100 %.
 CALIBRATIONS["linear/axle1"] = CALIBRATIONS["linear"]
+# Axles 2 and 4 alone (the other axle of a tandem; the rear axle) keep them too: checked, not
+# re-set (2026-11-27), on the same 20 drives per family fitted on that axle's four channels
+# (results/inverse_blind/20261127-axles-2-4-logger/): segments >= 3 s covered, axle 2 / axle 4,
+# 91 / 94 / 92 and 94 / 94 / 95 % (null), 86 / 97 / 91 and 91 / 95 / 92 % (friction, open loop),
+# 95 / 93 / 97 and 97 / 97 / 98 % (the independent truck) -- the pattern of axle 3 (w wide on
+# the friction drives, every quantity wide on the independent truck), no new failure.
+CALIBRATIONS["linear/axle2"] = CALIBRATIONS["linear"]
+CALIBRATIONS["linear/axle4"] = CALIBRATIONS["linear"]
 
 
 def calibration(fit_model: str = "simulation") -> dict:

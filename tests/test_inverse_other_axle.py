@@ -42,8 +42,9 @@ def drive(tmp_path_factory):
     return root, full
 
 
-def _invert(ds: Path, out: Path) -> dict:
-    assert main(["invert", str(ds), "--out", str(out), "--quick", "--segments", "1"]) == 0
+def _invert(ds: Path, out: Path, channels: str | None = None) -> dict:
+    extra = ["--channels", channels] if channels else []
+    assert main(["invert", str(ds), "--out", str(out), "--quick", "--segments", "1"] + extra) == 0
     return json.loads((out / "summary.json").read_text())
 
 
@@ -75,11 +76,16 @@ def test_front_axle_drive_is_inverted_on_axle_1_and_finds_axle_3s_road(drive, ca
     assert abs(lnG(a) - lnG(b)) <= 0.3, (lnG(a), lnG(b))
 
 
-def test_an_unchecked_axle_says_its_intervals_were_not_checked(drive):
+def test_an_unchecked_channel_list_says_its_intervals_were_not_checked(drive):
+    # axles 1, 2 and 4 alone were checked on blind drives (results/inverse_blind/
+    # 20261127-axle1-logger/, .../20261127-axles-2-4-logger/); a hand-made list was not
     root, full = drive
     s2 = _invert(_keep_axles(full, root / "axle2", [2]), root / "inv2")
-    assert s2["fit"]["channel_set"] == "axle2" and not s2["fit"]["uncertainty_calibrated_for_channels"]
-    assert "not checked on blind drives" in (root / "inv2" / "tables" / "table1.md").read_text()
+    assert s2["fit"]["channel_set"] == "axle2" and s2["fit"]["uncertainty_calibrated_for_channels"]
+    assert s2["fit"]["uncertainty_calibration"] == "linear/axle2"
+    sc = _invert(root / "axle2", root / "invc", channels="susp_disp_2L,susp_disp_2R,axle_acc_2L")
+    assert sc["fit"]["channel_set"] == "custom" and not sc["fit"]["uncertainty_calibrated_for_channels"]
+    assert "not checked on blind drives" in (root / "invc" / "tables" / "table1.md").read_text()
 
 
 def test_one_side_only_is_refused_with_one_line(drive, capsys):
