@@ -360,7 +360,8 @@ def plot_ranking(summary: Mapping, path: str | os.PathLike) -> Path:
     ax.set_xlabel("held-out gap: weighted mean of ln(P_sim/P_meas)^2 [-]")
     ax.set_title(f"verdict: {summary['verdict']} ({summary['verdict_confidence']}); green: accepted",
                  fontsize=9)
-    ax.legend(fontsize=7, loc="lower right")
+    # below the axes: inside them it covered the last bar's whisker
+    fig.legend(fontsize=7, loc="outside lower center", frameon=False)
     fig.savefig(path, dpi=130)
     return Path(path)
 
