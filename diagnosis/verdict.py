@@ -45,7 +45,9 @@ Vocabulary
        threshold passes 3. when it lies within the candidate's own scatter and the two-input
        one gives positive evidence (``ambiguous``, never ``identified``).  A near tie of the
        gap with a rival is broken by the transmissibility (:func:`decide`,
-       ``SIGNATURE_TIE_BREAK``).  ``identified``
+       ``SIGNATURE_TIE_BREAK``).  An effect listed in ``OWN_SIGNATURE`` (damper asymmetry) is
+       tested on its own road-independent signature instead of the transmissibility it barely
+       moves (:func:`own_signature_agrees`: the stroke-velocity skewness), both ways.  ``identified``
     (in the result) is True when the named effect's identity and value are not in doubt
     (no close rival, no range edge) even if a remainder keeps it from "clear": the
     closed loop (``diagnosis.closed_loop``) corrects with such an effect.  The front-to-rear delay and the amplitude distribution
