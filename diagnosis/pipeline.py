@@ -1343,24 +1343,19 @@ def close_rival(ranking):
 def _model_signature(model: TruckModel, sig: Signals, sim: Signals, tr, tr2, ranking, seed: int,
                       executor=None, entry=None):
     """The ranking winner's (or ``entry``'s) signature records (single- and two-input, each
-    with what the model reaches against its own records, :func:`signature_null`) and the
-    seconds taken; ``(None, None, None)`` without a winner.  The model's record (road phase
-    ``seed + 1``) and its surrogates run on ``executor`` when given."""
+    with what the model reaches against its own records, :func:`signature_null`), the
+    seconds taken and the model's noise-free records on the signature's road phases
+    (:func:`signature_seeds`; :func:`own_signature_record` reuses them);
+    ``(None, None, None, None)`` without a winner.  The records run on ``executor`` when given."""
     from diagnosis.compare import transmissibility
     from diagnosis.verdict import signature
 
     entry = entry if entry is not None else ranking.winner
     if entry is None:
-        return None, None, None
+        return None, None, None, None
     t = _time.perf_counter()
-    eff = entry.effects
-    T = sig.time.size / sig.fs
-    seeds = [seed + 1] + [seed + 2 + j for j in range(SIGNATURE_NULL_N)]
-    if executor is not None:
-        futs = [executor.submit(model.run, eff, 0.0, T, sd) for sd in seeds]
-        runs = [f.result() for f in futs]
-    else:
-        runs = [model.run(eff, 0.0, T, sd) for sd in seeds]
+    seeds = signature_seeds(seed)
+    runs = _phase_runs(model, entry.effects, sig.time.size / sig.fs, seeds, executor)
     simw = Signals(sig.time, model.add_noise(runs[0], seeds[0]), dict(sig.units), sig.speed,
                    {"model": entry.effect})
     null = signature_null(model, sig, simw, runs[1:], seeds[1:])
@@ -1369,17 +1364,31 @@ def _model_signature(model: TruckModel, sig: Signals, sim: Signals, tr, tr2, ran
     tr2w = two_input_or_none(sig, simw) if tr2 is not None else None
     if tr2w is not None:
         sig_w2 = signature(entry.effect, tr2, tr2w, method="two_input", null=null["two_input"])
-    return sig_w, sig_w2, _time.perf_counter() - t
+    return sig_w, sig_w2, _time.perf_counter() - t, runs
 
 
-def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, executor=None):
+def signature_seeds(seed: int) -> list:
+    """The road phases the signatures drive: ``seed + 1`` and the ``SIGNATURE_NULL_N`` after it."""
+    return [seed + 1] + [seed + 2 + j for j in range(SIGNATURE_NULL_N)]
+
+
+def _phase_runs(model: TruckModel, effects, T: float, seeds, executor=None) -> list:
+    """Noise-free records of ``model`` with ``effects`` over ``[0, T]`` on road phases ``seeds``."""
+    if executor is not None:
+        return [f.result() for f in [executor.submit(model.run, effects, 0.0, T, sd) for sd in seeds]]
+    return [model.run(effects, 0.0, T, sd) for sd in seeds]
+
+
+def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, executor=None,
+                         model_runs=None):
     """The ``signature_own`` record of a winner whose effect has a signature of its own
     (:data:`diagnosis.verdict.OWN_SIGNATURE`), and the seconds taken; ``(None, None)`` for
     any other effect.  The nominal model and the calibrated candidate each drive the road
-    phases of the transmissibility signature (``seed + 1`` and the ``SIGNATURE_NULL_N``
-    after it: the same roads for both, so the comparison is paired), with sensor noise, and
-    the statistic (:func:`diagnosis.compare.stroke_velocity_skewness`) is taken of every
-    record and of the measurement."""
+    phases of the transmissibility signature (:func:`signature_seeds`: the same roads for
+    both, so the comparison is paired), with sensor noise, and the statistic
+    (:func:`diagnosis.compare.stroke_velocity_skewness`) is taken of every record and of the
+    measurement.  ``model_runs``: the candidate's records on those phases where already made
+    (:func:`_model_signature` returns them), else they are run here."""
     from diagnosis.compare import stroke_velocity_skewness
     from diagnosis.verdict import OWN_SIGNATURE, own_signature
 
@@ -1387,16 +1396,17 @@ def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, exec
         return None, None
     t = _time.perf_counter()
     T = sig.time.size / sig.fs
-    seeds = [seed + 1] + [seed + 2 + j for j in range(SIGNATURE_NULL_N)]
-    jobs = [(eff, sd) for eff in ({}, entry.effects) for sd in seeds]
-    if executor is not None:
-        runs = [f.result() for f in [executor.submit(model.run, eff, 0.0, T, sd) for eff, sd in jobs]]
-    else:
-        runs = [model.run(eff, 0.0, T, sd) for eff, sd in jobs]
-    vals = [stroke_velocity_skewness(Signals(sig.time, model.add_noise(r, sd), dict(sig.units),
-                                             sig.speed, {})) for r, (_, sd) in zip(runs, jobs)]
-    n = len(seeds)
-    rec = own_signature(entry.effect, stroke_velocity_skewness(sig), vals[:n], vals[n:])
+    seeds = signature_seeds(seed)
+    if model_runs is None:
+        model_runs = _phase_runs(model, entry.effects, T, seeds, executor)
+    nominal_runs = _phase_runs(model, {}, T, seeds, executor)
+
+    def stat(runs):
+        return [stroke_velocity_skewness(Signals(sig.time, model.add_noise(r, sd), dict(sig.units),
+                                                 sig.speed, {})) for r, sd in zip(runs, seeds)]
+
+    rec = own_signature(entry.effect, stroke_velocity_skewness(sig), stat(nominal_runs),
+                        stat(model_runs))
     return rec, _time.perf_counter() - t
 
 
@@ -1517,11 +1527,11 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         # single-input ratio (``signature``) and the two-input estimate (``signature_two_input``,
         # where both sides are measured), each with what the winner reaches against itself;
         # the verdict uses diagnosis.verdict.SIGNATURE_METHOD
-        sig_w, sig_w2, t_sig = _model_signature(model, sig, sim, tr, tr2, ranking, seed, ex)
+        sig_w, sig_w2, t_sig, runs_w = _model_signature(model, sig, sim, tr, tr2, ranking, seed, ex)
         if t_sig is not None:
             timing["signature_s"] = t_sig
         # an effect the transmissibility cannot test (damper asymmetry): its own signature
-        sig_own, t_own = own_signature_record(model, sig, ranking.winner, seed, ex)
+        sig_own, t_own = own_signature_record(model, sig, ranking.winner, seed, ex, model_runs=runs_w)
         if t_own is not None:
             timing["signature_own_s"] = t_own
         # a rival within noise of the winner's gap: its signature too, so the verdict can
@@ -1529,7 +1539,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         rival = close_rival(ranking)
         sig_r = None
         if rival is not None:
-            r1, r2, t_r = _model_signature(model, sig, sim, tr, tr2, ranking, seed, ex,
+            r1, r2, t_r, _ = _model_signature(model, sig, sim, tr, tr2, ranking, seed, ex,
                                             entry=rival)
             sig_r = {"effect": rival.effect, "single_input": r1, "two_input": r2}
             timing["signature_rival_s"] = t_r

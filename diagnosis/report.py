@@ -470,11 +470,9 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                      f"{O['sd']:.2g}): measured {O['measured']:+.2f}, nominal model "
                      f"{O['nominal_mean']:+.2f} (z {O['z_nominal']:+.1f}), with "
                      f"{R['model'] if R['model'] != 'nominal' else 'the effect'} "
-                     f"{O['model_mean']:+.2f} (z {O['z_model']:+.1f}); "
-                     + ("it singles the effect out; the verdict uses it instead of the "
-                        "transmissibility." if O["agrees"] else
-                        "it does not single the effect out; the verdict uses it instead of the "
-                        "transmissibility."))
+                     f"{O['model_mean']:+.2f} (z {O['z_model']:+.1f}); it "
+                     + ("singles" if O["agrees"] else "does not single")
+                     + " the effect out; the verdict uses it instead of the transmissibility.")
         if D.get("edge"):
             L.append(f" Calibrated at the edge of the search range: {', '.join(D['edge'])}.")
         L.append("")
