@@ -1124,13 +1124,36 @@ def distribution_shape(measured, simulated, *, channels: Sequence[str] | None = 
 STROKE_VELOCITY_BAND = (0.5, 15.0)
 
 
+def stroke_velocity_skewness_per_channel(signals, band: tuple[float, float] = STROKE_VELOCITY_BAND,
+                                         quantity: str = "susp_disp") -> dict:
+    """Skewness of the suspension stroke velocity of every ``quantity`` channel (name ->
+    value; a constant channel is left out): each channel band-passed (``band``,
+    fourth-order Butterworth, zero phase), differentiated, and its skewness
+    ``E[v^3] / E[v^2]^1.5`` taken (the biased estimator, ``scipy.stats.skew``).  The
+    station mean is :func:`stroke_velocity_skewness`; the per-window term of the gap is
+    :class:`diagnosis.which.StrokeVelocityTerm`."""
+    from scipy.signal import butter, sosfiltfilt
+
+    sig = as_signals(signals)
+    names = sorted(c for c in sig.channels if c.startswith(quantity + "_"))
+    if not names:
+        return {}
+    hi = min(float(band[1]), 0.45 * sig.fs)
+    sos = butter(4, [float(band[0]), hi], btype="band", fs=sig.fs, output="sos")
+    out = {}
+    for c in names:
+        v = np.gradient(sosfiltfilt(sos, np.asarray(sig.channels[c], float)), 1.0 / sig.fs)
+        if np.ptp(v) > 0:
+            out[c] = float(stats.skew(v))
+    return out
+
+
 def stroke_velocity_skewness(signals, band: tuple[float, float] = STROKE_VELOCITY_BAND,
                              quantity: str = "susp_disp") -> float | None:
-    """Skewness of the suspension stroke velocity, averaged over the wheel stations.
+    """Skewness of the suspension stroke velocity, averaged over the wheel stations
+    (:func:`stroke_velocity_skewness_per_channel`).
 
-    Each ``susp_disp_*`` channel is band-passed (``band``, fourth-order Butterworth, zero
-    phase) and differentiated; the skewness ``E[v^3] / E[v^2]^1.5`` of each station's velocity
-    is averaged over the stations.  Why this statistic: a linear truck on a Gaussian road has
+    Why this statistic: a linear truck on a Gaussian road has
     Gaussian stroke velocities (skewness 0 whatever the road spectrum, speed or the truck's
     stiffnesses), and a displacement sensor's offset or a gain drops out.  A damper whose
     rebound and compression coefficients differ makes the velocity distribution lopsided
@@ -1140,20 +1163,8 @@ def stroke_velocity_skewness(signals, band: tuple[float, float] = STROKE_VELOCIT
     station mean within +-0.05 over road phases; a damper asymmetry 2.94 gave +0.24..+0.53
     per station (mean +0.35).  None where the record has no such channel.
     """
-    from scipy.signal import butter, sosfiltfilt
-
-    sig = as_signals(signals)
-    names = sorted(c for c in sig.channels if c.startswith(quantity + "_"))
-    if not names:
-        return None
-    hi = min(float(band[1]), 0.45 * sig.fs)
-    sos = butter(4, [float(band[0]), hi], btype="band", fs=sig.fs, output="sos")
-    out = []
-    for c in names:
-        v = np.gradient(sosfiltfilt(sos, np.asarray(sig.channels[c], float)), 1.0 / sig.fs)
-        if np.ptp(v) > 0:
-            out.append(float(stats.skew(v)))          # m3 / m2^1.5, the biased estimator
-    return float(np.mean(out)) if out else None
+    out = stroke_velocity_skewness_per_channel(signals, band, quantity)
+    return float(np.mean(list(out.values()))) if out else None
 
 
 def sprague_geers(measured: np.ndarray, computed: np.ndarray) -> tuple[float, float, float]:

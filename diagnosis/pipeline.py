@@ -98,6 +98,14 @@ PRE_LEVEL = True
 #: :class:`diagnosis.which.ShapeTerm`): what separates a bump stop from a payload error
 #: with the same spectra (blind case 13: measured skewness -0.4 to -1.1, nominal 0, se 0.13)
 SHAPE_TERM = True
+#: the skewness of the suspension stroke velocity as a term of every gap
+#: (:func:`stroke_velocity_term`, :class:`diagnosis.which.StrokeVelocityTerm`); experimental,
+#: off: tried 2026-11-27 to pin a damper asymmetry's ratio (the band gap is flat towards high
+#: ratios), but per 7.5 s window the statistic follows the road phase (nominal model on one
+#: calibration window: +0.36 and +0.14 on two phases, sigma 0.35 against 0.02 for a
+#: Gaussian road), so at the common term weight it is mostly noise: blind case 15's folds
+#: moved from 2.34 / 8.0 to 2.34 / 1.75 for a 3.71 truth (docs/diagnosis.md, "Left")
+STROKE_VELOCITY_TERM = False
 
 #: candidate search ranges (name -> {param: (lo, hi)}, primary parameter only) narrower
 #: than the library's validity ranges: the physically sensible span of a model error
@@ -109,7 +117,10 @@ SEARCH = {
     "frame_flex": {"stiffness_factor": (0.1, 100.0)},
     "tyre_enveloping": {"length": (0.1, 0.6)},
     "leaf_friction": {"force": (200.0, 12000.0)},
-    "bump_stop": {"gap": (0.005, 0.08)},
+    # from 1 mm (was 5 mm, the blind draw's own lower end: a 6.7 mm truth calibrated at 5 mm
+    # in one fold and the edge rule withheld the name by construction, blind cases 3 and 14
+    # of 20261127-own-signature-fresh-40); a stop touching at rest (0) simulates
+    "bump_stop": {"gap": (0.001, 0.08)},
     # the library's own range (0.3-6 until 2026-11-27: a 4.25 truth calibrated at 6.0 in one
     # fold and the edge rule withheld the name, blind case 15 of 20261127-relevel-fresh-40)
     "damper_asymmetry": {"ratio": (0.2, 8.0)},
@@ -1224,6 +1235,15 @@ def shape_term(model: TruckModel):
     return ShapeTerm(ch) if ch and SHAPE_TERM else None
 
 
+def stroke_velocity_term(model: TruckModel):
+    """The stroke-velocity term of the gap (:class:`diagnosis.which.StrokeVelocityTerm`): the
+    skewness of the stroke velocity of every suspension displacement channel."""
+    from diagnosis.which import StrokeVelocityTerm
+
+    ch = [c for c in model.channels if c.startswith("susp_disp_")]
+    return StrokeVelocityTerm(ch) if ch and STROKE_VELOCITY_TERM else None
+
+
 def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: int = 4,
                    n_windows: int = 4, n_null: int = 12, delay: bool = True) -> dict:
     """Held-out gap of the nominal model and of the model with ``effects`` (given, not
@@ -1245,7 +1265,8 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
                   n_windows=n_windows)
     sc = _Scorer(Fit(ctx.model), Simulate(ctx.model), ctx.calib, ctx.held, seed, 1, n_seeds,
                  None, None)
-    terms = [delay_term(ctx.model), shape_term(ctx.model), transmissibility_term(ctx.model)] if delay else []
+    terms = [delay_term(ctx.model), shape_term(ctx.model), transmissibility_term(ctx.model),
+             stroke_velocity_term(ctx.model)] if delay else []
     surrogates = _set_terms(sc, terms, n_null)
     sc.set_null(surrogates)
     g0, m0 = sc.heldout_scores({})
@@ -1517,7 +1538,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     try:
         rankings = [rank_effects(cands, fit, simulate, c, h, seed=sd, executor=ex,
                                  progress=progress, delay=delay_term(model),
-                                 shape=shape_term(model), extra_terms=[transmissibility_term(model)],
+                                 shape=shape_term(model),
+                                 extra_terms=[transmissibility_term(model), stroke_velocity_term(model)],
                                  **kw)
                     for c, h, sd in splits]
         ranking = rankings[0] if folds == 1 else combine_folds(rankings, candidates=cands)

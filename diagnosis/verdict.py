@@ -283,6 +283,17 @@ OWN_SHARE = 0.5
 #: come out small by chance; 0.03 is below every value measured on the development drives
 #: (0.011-0.23 for the station mean over 3 road phases, mostly 0.05)
 OWN_SD_FLOOR = 0.03
+#: a winner calibrated at an edge of its search range is still named (``ambiguous``, never
+#: ``clear`` nor ``identified``, the value a bound) when its own road-independent signature
+#: agrees: the edge rule withholds a name because a value pinned at the range's end may
+#: stand for another difference the range cannot hold, and the own signature is the
+#: independent test of identity the transmissibility is not.  Decided 2026-11-27 from the
+#: saved blind sets (docs/diagnosis.md, "Edge and own signature"): an edge-free re-decision
+#: of every saved summary names 7 right and 10 wrong (some drives decided in several sets);
+#: every wrong one is on the independent truck (payload at -14 t on friction drives 6, a
+#: damper ratio at 6 before the own signature existed 3, frame 1), and the one edge winner
+#: with an own signature record was right (our truck, ratio 3.71 at 2.34 / 8.0)
+OWN_EDGE_NAMES = True
 
 
 def own_signature(effect: str, measured: float, nominal, model) -> dict:
@@ -618,7 +629,8 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                         else "")
                      + (f"; off: {', '.join(sig.get('pairs_off', [])[:4])}" if sig.get("pairs_off")
                         else "") + ")")
-    if edges:
+    edge_named = bool(edges and OWN_EDGE_NAMES and own_res is not None and agrees)
+    if edges and not edge_named:
         # a winner pinned at its search range's end is not an estimate: the data ask for
         # more than the range holds; on the saved blind sets every such name was wrong (3 of
         # 3, independent truck: payload -> damper ratio at 6, leaf friction -> payload at
@@ -650,6 +662,11 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     if remainder and conf == "clear":
         conf = "ambiguous"
         reason += " (so not 'clear')"
+    if edge_named:
+        conf = "ambiguous"
+        reason += (f"; it calibrates at the edge of its search range ({', '.join(edges)}) in "
+                   f"{'a fold' if len(win.get('parameters_per_fold') or []) > 1 else 'the fit'}: "
+                   f"named on its own signature, the value is a bound -- not 'clear', no correction")
     if on_signature:
         conf = "ambiguous"
         reason += (f"; named on its {what}: it removes {sig_frac:.0%} of the nominal model's excess "

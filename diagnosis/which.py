@@ -711,6 +711,47 @@ class ShapeTerm(WindowTerm):
 
 
 @dataclass
+class StrokeVelocityTerm(WindowTerm):
+    """Stroke-velocity asymmetry as a term of the gap: the skewness of the suspension stroke
+    velocity of every ``channels`` (suspension displacement) per window
+    (:func:`diagnosis.compare.stroke_velocity_skewness_per_channel`).  Road-independent in
+    expectation (0 for a linear truck on a Gaussian road); a damper whose rebound and
+    compression differ skews it, and its size follows the ratio, which the band powers
+    hardly see (blind case 15 of ``20261127-own-signature-fresh-40``: the two folds
+    calibrated a 3.71 ratio at 2.34 and 8.0).  In the gap it pins that ratio and penalises
+    any candidate that skews the velocity more or less than measured.  ``rho_j`` is the mean
+    over the channels of ``skew_sim - skew_meas``; the rest as :class:`WindowTerm`.
+    """
+
+    channels: list
+
+    #: the per-window skewness of a 7.5 s window scatters by about 0.1 between road phases
+    #: (development drives); the floor as :class:`ShapeTerm`'s
+    SIGMA_FLOOR = 0.02
+    label = "stroke velocity"
+
+    def stats(self, windows) -> np.ndarray:
+        """Stroke-velocity skewness per window and channel, (W, C) array."""
+        from .compare import stroke_velocity_skewness_per_channel
+        from .signals import as_signals
+
+        out = np.full((len(windows), len(self.channels)), np.nan)
+        for j, w in enumerate(windows):
+            sig = as_signals(w)
+            sk = stroke_velocity_skewness_per_channel(sig)
+            for k, c in enumerate(self.channels):
+                if c in sk:
+                    out[j, k] = sk[c]
+        return out
+
+    @staticmethod
+    def _rho(ls: np.ndarray, lm: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return np.nanmean(ls - lm, axis=1)
+
+
+@dataclass
 class TransmissibilityTerm(WindowTerm):
     """Axle-to-body transmissibility mismatch as a term of the gap (road-independent in the
     main: a heavier body, a locked leaf spring or a stiffer mount changes how the body answers

@@ -17,7 +17,7 @@ class BumpStop(Effect):
         "impacts: body accelerations get heavier tails (higher kurtosis and peaks) and more "
         "high-frequency content.")
     parameters = (
-        Parameter("gap", "m", 0.04, (0.005, 0.3),
+        Parameter("gap", "m", 0.04, (0.0, 0.3),
                   "free compression travel from static equilibrium"),
         Parameter("stiffness", "N/m", 2.0e6, (1.0e4, 5.0e7), "contact stiffness"),
         Parameter("smoothing", "m", 0.002, (1.0e-4, 0.02),
