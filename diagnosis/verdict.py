@@ -510,6 +510,81 @@ def decide(summary: Mapping, *, tie_break: bool = SIGNATURE_TIE_BREAK, **kw) -> 
                         f"{R['effect']} is named -- not 'clear', no correction"))
 
 
+@dataclass
+class _SignatureTest:
+    """Outcome of test 3. for one winner (:func:`_signature_test`)."""
+
+    agrees: bool | None            # None: no signature record
+    c0: float | None               # nominal / candidate mean z^2 of the transmissibility
+    c1: float | None
+    sig_max: float                 # the mean z^2 the transmissibility was held to
+    corroborated: bool = False     # passed on the two-input corroboration
+    own: dict | None = None        # own-signature numbers, where that test replaced it
+
+
+#: how the reason names the two signatures
+_WHAT_OWN = ("stroke-velocity skewness (its own signature; the transmissibility, which it "
+             "barely moves, is not used)")
+
+
+def _what(sig_method: str) -> str:
+    return ("two-input axle-to-body transmissibility" if sig_method == "two_input"
+            else "axle-to-body transmissibility")
+
+
+def _signature_test(summary: Mapping, win: Mapping, sig: Mapping, sig_method: str, *,
+                    signature_max: float, signature_share: float, signature_null: bool,
+                    corroborate: bool, own: bool) -> _SignatureTest:
+    """Test 3.: the chosen transmissibility record against its threshold, the two-input
+    corroboration of an off single-input one, and -- for an effect with an own signature
+    (``OWN_SIGNATURE``) -- the own signature instead, both ways."""
+    c0, c1 = sig.get("chi2_nominal"), sig.get("chi2_model")
+    sig_max = signature_threshold(sig, signature_max) if signature_null else float(signature_max)
+    agrees = signature_agrees(c0, c1, sig_max, signature_share)
+    corroborated = False
+    if agrees is False and corroborate and sig_method == "single_input":
+        s2 = summary.get("signature_two_input") or {}
+        own_max = signature_threshold(sig, signature_max)
+        d0, d1 = s2.get("chi2_nominal"), s2.get("chi2_model")
+        # positive evidence: the nominal model's two-input transmissibility is off and the
+        # candidate removes at least CORROBORATE_SHARE of its excess (an effect that acts
+        # on axle and body alike leaves it where it was and corroborates nothing)
+        a2 = bool((s2.get("n_cells") or 0) > 0 and d0 is not None and d1 is not None
+                  and d0 > signature_max and (d0 - d1) / (d0 - 1.0) >= CORROBORATE_SHARE)
+        if sig.get("chi2_correct_model") and c1 is not None and c1 <= own_max and a2:
+            agrees, corroborated = True, True
+            sig_max = own_max
+    # an effect with a signature of its own (OWN_SIGNATURE) is tested on it, both ways:
+    # the transmissibility it barely moves neither confirms nor refutes it
+    rec_own = summary.get("signature_own") or {}
+    if own and win["effect"] in OWN_SIGNATURE and rec_own.get("effect") == win["effect"]:
+        own_res = own_signature_agrees(rec_own)
+        if own_res["agrees"] is not None:
+            return _SignatureTest(own_res["agrees"], c0, c1, sig_max, False, own_res)
+    return _SignatureTest(agrees, c0, c1, sig_max, corroborated, None)
+
+
+def _no_winner(summary: Mapping, base: dict, gap_present: bool) -> dict:
+    """``none`` (no gap beyond noise) or ``unexplained`` (a gap no candidate reduces)."""
+    nom = summary.get("nominal") or {}
+    rd = summary.get("ranking_decision") or {}
+    ranking = list(summary.get("ranking") or [])
+    if not gap_present:
+        return dict(base, verdict="none", confidence="none",
+                    reason=rd.get("reason") or "no gap beyond noise",
+                    residual=residual(summary, None))
+    best = ranking[0] if ranking else None
+    return dict(base, verdict="unexplained", confidence="none",
+                closest=best["effect"] if best else None,
+                explained_share=_f(explained_share(best, nom)) if best else None,
+                reason=("the nominal model leaves a held-out gap beyond noise (gap "
+                        f"{nom.get('heldout_gap', float('nan')):.3g} against "
+                        f"{nom.get('null_gap_mean', float('nan')):.3g} +- "
+                        f"{nom.get('null_gap_std', float('nan')):.2g} for a correct model) and "
+                        "no library effect reduces it beyond noise"),
+                residual=residual(summary, None))
+
+
 def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                signature_max: float = SIGNATURE_CHI2_MAX,
                signature_share: float = SIGNATURE_SHARE_MIN,
@@ -551,55 +626,19 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             "thresholds": thresholds, "ranking_verdict": rv,
             "ranking_confidence": rd.get("confidence", "none")}
     if win is None:
-        if not gap_present:
-            return dict(base, verdict="none", confidence="none",
-                        reason=rd.get("reason") or "no gap beyond noise",
-                        residual=residual(summary, None))
-        best = ranking[0] if ranking else None
-        return dict(base, verdict="unexplained", confidence="none",
-                    closest=best["effect"] if best else None,
-                    explained_share=_f(explained_share(best, nom)) if best else None,
-                    reason=("the nominal model leaves a held-out gap beyond noise (gap "
-                            f"{nom.get('heldout_gap', float('nan')):.3g} against "
-                            f"{nom.get('null_gap_mean', float('nan')):.3g} +- "
-                            f"{nom.get('null_gap_std', float('nan')):.2g} for a correct model) and "
-                            "no library effect reduces it beyond noise"),
-                    residual=residual(summary, None))
+        return _no_winner(summary, base, gap_present)
+
+    # --- the tests: 2. share, 3. signature, and the range edge
     share = explained_share(win, nom)
     edges = _entry_edges(win, ranges)
-    c0, c1 = sig.get("chi2_nominal"), sig.get("chi2_model")
-    what = ("two-input axle-to-body transmissibility" if sig_method == "two_input"
-            else "axle-to-body transmissibility")
-    sig_max = signature_threshold(sig, signature_max) if signature_null else float(signature_max)
-    agrees = signature_agrees(c0, c1, sig_max, signature_share)
-    corroborated = False
-    if agrees is False and corroborate and sig_method == "single_input":
-        s2 = summary.get("signature_two_input") or {}
-        own_max = signature_threshold(sig, signature_max)
-        d0, d1 = s2.get("chi2_nominal"), s2.get("chi2_model")
-        # positive evidence: the nominal model's two-input transmissibility is off and the
-        # candidate removes at least CORROBORATE_SHARE of its excess (an effect that acts
-        # on axle and body alike leaves it where it was and corroborates nothing)
-        a2 = bool((s2.get("n_cells") or 0) > 0 and d0 is not None and d1 is not None
-                  and d0 > signature_max and (d0 - d1) / (d0 - 1.0) >= CORROBORATE_SHARE)
-        if sig.get("chi2_correct_model") and c1 is not None and c1 <= own_max and a2:
-            agrees, corroborated = True, True
-            sig_max = own_max
-    # an effect with a signature of its own (OWN_SIGNATURE) is tested on it, both ways:
-    # the transmissibility it barely moves neither confirms nor refutes it
-    rec_own = summary.get("signature_own") or {}
-    own_res = None
-    if own and win["effect"] in OWN_SIGNATURE and rec_own.get("effect") == win["effect"]:
-        own_res = own_signature_agrees(rec_own)
-        if own_res["agrees"] is not None:
-            agrees, corroborated = own_res["agrees"], False
-        else:
-            own_res = None
+    st = _signature_test(summary, win, sig, sig_method, signature_max=signature_max,
+                         signature_share=signature_share, signature_null=signature_null,
+                         corroborate=corroborate, own=own)
+    agrees, c0, c1, sig_max, own_res = st.agrees, st.c0, st.c1, st.sig_max, st.own
+    what = _what(sig_method)
     out = dict(base, explained_share=_f(share), closest=win["effect"], edge=edges,
                signature_agrees=agrees, signature_max=_f(sig_max), residual=residual(summary, win),
-               signature_corroborated=corroborated)
-    what_own = ("stroke-velocity skewness (its own signature; the transmissibility, which it "
-                "barely moves, is not used)")
+               signature_corroborated=st.corroborated)
     if own_res is not None:
         out["signature_own"] = {k: (_f(v) if isinstance(v, float) else v)
                                 for k, v in own_res.items()}
@@ -607,17 +646,20 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     if own_res is None and agrees and c1 is not None and c1 > sig_max:
         remainder = (f"; its {what} moves towards the measurement (mean z^2 {c0:.2g} "
                      f"-> {c1:.2g}) but stays off: a difference beyond it remains")
-    short = []
     sig_frac = ((c0 - c1) / (c0 - 1.0) if c0 is not None and c1 is not None and c0 > sig_max
                 else float("nan"))
     on_signature = bool(own_res is None and not (share >= share_min) and share > 0
                         and sig_frac >= SIGNATURE_STRONG and gap_present)
+    edge_named = bool(edges and OWN_EDGE_NAMES and own_res is not None and agrees)
+
+    # --- what fails: any failure leaves the drive unexplained (but see on_gap_alone)
+    short = []
     if not (share >= share_min) and not on_signature:
         short.append(f"it explains {share:.0%} of the held-out gap above a correct model's "
                      f"(at least {share_min:.0%} asked)" if math.isfinite(share) else
                      "its share of the gap above a correct model's is undefined")
     if agrees is False and own_res is not None:
-        short.append(f"its {what_own} does not single it out: measured "
+        short.append(f"its {_WHAT_OWN} does not single it out: measured "
                      f"{own_res['measured']:+.2f}, nominal model {own_res['nominal_mean']:+.2f} "
                      f"(z {own_res['z_nominal']:+.1f}, at least {OWN_Z_NOMINAL:g} asked), "
                      f"{win['effect']} {own_res['model_mean']:+.2f} (z {own_res['z_model']:+.1f}, "
@@ -629,7 +671,6 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                         else "")
                      + (f"; off: {', '.join(sig.get('pairs_off', [])[:4])}" if sig.get("pairs_off")
                         else "") + ")")
-    edge_named = bool(edges and OWN_EDGE_NAMES and own_res is not None and agrees)
     if edges and not edge_named:
         # a winner pinned at its search range's end is not an estimate: the data ask for
         # more than the range holds; on the saved blind sets every such name was wrong (3 of
@@ -649,6 +690,8 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                             f"{win['effect']}, shrinks the held-out gap from "
                             f"{win['heldout_gap_before']:.3g} to {win['heldout_gap_after']:.3g}, but "
                             + "; and ".join(short)))
+
+    # --- named: the reason, and each caveat that keeps it from "clear"
     conf = rd.get("confidence", "clear")
     reason = rd.get("reason") or ""
     reason += (f"; it explains {share:.0%} of the gap above a correct model's"
@@ -656,61 +699,62 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                   f"; its {what} agrees with the measurement")
                + remainder)
     if own_res is not None:
-        reason += (f"; its {what_own} agrees: measured {own_res['measured']:+.2f}, nominal model "
+        reason += (f"; its {_WHAT_OWN} agrees: measured {own_res['measured']:+.2f}, nominal model "
                    f"{own_res['nominal_mean']:+.2f} (z {own_res['z_nominal']:+.1f}), {win['effect']} "
                    f"{own_res['model_mean']:+.2f} (z {own_res['z_model']:+.1f})")
+    caveats = []
     if remainder and conf == "clear":
-        conf = "ambiguous"
-        reason += " (so not 'clear')"
+        caveats.append(" (so not 'clear')")
     if edge_named:
-        conf = "ambiguous"
-        reason += (f"; it calibrates at the edge of its search range ({', '.join(edges)}) in "
-                   f"{'a fold' if len(win.get('parameters_per_fold') or []) > 1 else 'the fit'}: "
-                   f"named on its own signature, the value is a bound -- not 'clear', no correction")
+        caveats.append(f"; it calibrates at the edge of its search range ({', '.join(edges)}) in "
+                       f"{'a fold' if len(win.get('parameters_per_fold') or []) > 1 else 'the fit'}: "
+                       f"named on its own signature, the value is a bound -- not 'clear', no correction")
     if on_signature:
-        conf = "ambiguous"
-        reason += (f"; named on its {what}: it removes {sig_frac:.0%} of the nominal model's excess "
-                   f"there (mean z^2 {c0:.2g} -> {c1:.2g}) though it explains only {share:.0%} of the "
-                   f"held-out gap above a correct model's ({share_min:.0%} asked otherwise): a larger "
-                   f"difference no library effect lists remains beside it -- not 'clear', no correction")
+        caveats.append(
+            f"; named on its {what}: it removes {sig_frac:.0%} of the nominal model's excess "
+            f"there (mean z^2 {c0:.2g} -> {c1:.2g}) though it explains only {share:.0%} of the "
+            f"held-out gap above a correct model's ({share_min:.0%} asked otherwise): a larger "
+            f"difference no library effect lists remains beside it -- not 'clear', no correction")
     if on_gap_alone:
-        conf = "ambiguous"
-        reason += (f"; named on the gap alone: with it the held-out gap ({res['heldout_gap']:.3g}) is "
-                   f"a correct model's ({res['correct_model_gap']:.3g} +- {res['correct_model_sd']:.2g}), "
-                   f"but its {what} stays off (mean z^2 {c1:.2g}, nominal {c0:.2g}, at most "
-                   f"{sig_max:.2g} asked): the effect does not bring it nearer, so the "
-                   f"signature cannot confirm it, and what keeps the transmissibility off (a difference "
-                   f"beyond it, or this drive's noise) is not known -- not 'clear', no correction")
-    if corroborated:
+        caveats.append(
+            f"; named on the gap alone: with it the held-out gap ({res['heldout_gap']:.3g}) is "
+            f"a correct model's ({res['correct_model_gap']:.3g} +- {res['correct_model_sd']:.2g}), "
+            f"but its {what} stays off (mean z^2 {c1:.2g}, nominal {c0:.2g}, at most "
+            f"{sig_max:.2g} asked): the effect does not bring it nearer, so the "
+            f"signature cannot confirm it, and what keeps the transmissibility off (a difference "
+            f"beyond it, or this drive's noise) is not known -- not 'clear', no correction")
+    if st.corroborated:
         s2 = summary["signature_two_input"]
-        conf = "ambiguous"
-        reason += (f"; its single-input transmissibility (mean z^2 {c1:.2g}) is off by the fixed "
-                   f"threshold ({signature_max:.2g}) but within what the model reaches against "
-                   f"itself on other road phases (up to {sig_max:.2g}), and its two-input "
-                   f"transmissibility agrees (mean z^2 {s2['chi2_nominal']:.2g} -> "
-                   f"{s2['chi2_model']:.2g}): corroborated, not 'clear', no correction")
+        caveats.append(
+            f"; its single-input transmissibility (mean z^2 {c1:.2g}) is off by the fixed "
+            f"threshold ({signature_max:.2g}) but within what the model reaches against "
+            f"itself on other road phases (up to {sig_max:.2g}), and its two-input "
+            f"transmissibility agrees (mean z^2 {s2['chi2_nominal']:.2g} -> "
+            f"{s2['chi2_model']:.2g}): corroborated, not 'clear', no correction")
     z_abs = improvement_z(win)
     weak = z_abs is not None and z_abs < CLEAR_Z_MIN
     if weak:
-        conf = "ambiguous"
-        reason += (f"; it improves on the nominal model by only {z_abs:.1f} sd of its paired noise "
-                   f"({CLEAR_Z_MIN:g} asked for 'clear')")
+        caveats.append(f"; it improves on the nominal model by only {z_abs:.1f} sd of its paired "
+                       f"noise ({CLEAR_Z_MIN:g} asked for 'clear')")
     if not gap_present:
         # the paired comparison can see an effect the whole gap's road-phase scatter hides,
         # but then the share above is a ratio over a difference within noise (it can read
         # far over 100 %): a name that rests on the paired test alone is never 'clear'
+        caveats.append(
+            f"; the nominal model's own held-out gap ({nom.get('heldout_gap', float('nan')):.3g}) "
+            f"is within a correct model's scatter ({nom.get('null_gap_mean', float('nan')):.3g} +- "
+            f"{nom.get('null_gap_std', float('nan')):.2g}): the name rests on the paired "
+            f"comparison alone, and the share is not a measure here")
+    if caveats:
         conf = "ambiguous"
-        reason += (f"; the nominal model's own held-out gap ({nom.get('heldout_gap', float('nan')):.3g}) "
-                   f"is within a correct model's scatter ({nom.get('null_gap_mean', float('nan')):.3g} +- "
-                   f"{nom.get('null_gap_std', float('nan')):.2g}): the name rests on the paired "
-                   f"comparison alone, and the share is not a measure here")
+        reason += "".join(caveats)
     # identified: the effect is named and neither a rival nor a range edge puts its identity
     # or value in doubt (a remainder beyond it does not), and there is a gap beyond noise to
     # correct: what a correction may use
     return dict(out, verdict=rv, confidence=conf, reason=reason,
                 identified=bool(rd.get("confidence") == "clear" and not edges and gap_present
                                 and not weak and not on_gap_alone and not on_signature
-                                and not corroborated))
+                                and not st.corroborated))
 
 
 def improvement_z(entry: Mapping) -> float | None:
