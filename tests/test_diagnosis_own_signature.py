@@ -271,6 +271,9 @@ def test_stroke_velocity_term_pins_the_damper_ratio():
     assert 2.0 <= best <= 4.5, dict(zip(ratios, np.round(terms, 2)))
     # the ends are penalised, not flat: 1 and 8 cost more than the truth's neighbourhood
     assert terms[-1] > min(terms) + 1.0 and terms[0] > min(terms) + 10.0
+    # and z says which way: the symmetric damper skews less than measured (z > 0), a ratio
+    # of 8 more (z < 0)
+    assert term.z(_windows(8.0, seed=41), "held") < 0.0 < z_nominal
     # the term is 0 without weight and before it is prepared for a window set
     assert StrokeVelocityTerm(ch).term(meas, "held") == 0.0
     assert term.term(meas, "calib") == 0.0
