@@ -128,6 +128,18 @@ SEARCH = {
     "speed_scale": {"factor": (0.85, 1.15)},
     "sensor": {"cutoff": (3.0, 60.0)},
 }
+#: an effect with an own signature (``diagnosis.verdict.OWN_SIGNATURE``) is searched on the
+#: side of its neutral value that the measured signature shows (:func:`own_side_record`):
+#: a damper asymmetry's stroke-velocity skewness gives the sign of ``ratio - 1`` without the
+#: road (skewness 0 for a linear truck on a Gaussian road), while the band gap can be flat or
+#: two-basined across 1 -- blind cases with a damper asymmetry of 3.85, 3.8 and 2.12 had one
+#: fold calibrate at 0.2, 0.3 and 0.64 (diag seeds 67 case 5, 20261127-fresh-40 case 5,
+#: 20261125-nominal-liftoff-seed19 case 4).  Only where the measurement lies at least
+#: ``verdict.OWN_Z_NOMINAL`` prediction sd from the nominal model (the verdict's own
+#: threshold); else the library's whole range.  Added 2026-11-27, after those sets.
+OWN_SIDE = True
+#: the search ranges of each side: effect -> (param, range above the neutral value, range below)
+OWN_SIDE_RANGES = {"damper_asymmetry": ("ratio", (1.0, 8.0), (0.2, 1.0))}
 #: parameters held fixed in the candidates (the sensor's noise is part of the nominal model)
 FIXED = {"sensor": {"acc_noise": 0.0, "disp_noise": 0.0}}
 #: smallest speed factor (recorded / true speed) a simulation may use: every road is made
@@ -1065,10 +1077,11 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
     return gq, w
 
 
-def candidates(names=None, vehicle=None):
+def candidates(names=None, vehicle=None, sides=None):
     """Candidates over the library, primary parameter only, ranges of :data:`SEARCH`
     narrowed to what the effect allows on ``vehicle`` (``Effect.vehicle_ranges``: payload
-    never below an empty truck)."""
+    never below an empty truck); ``sides``: effect -> +1 / -1 / 0, the side of the neutral
+    value an effect of :data:`OWN_SIDE_RANGES` is searched on (0: the whole range)."""
     from diagnosis.which import Candidate, Param
     from vehicles.effects import EFFECTS
     from vehicles.params import load_vehicle
@@ -1083,6 +1096,9 @@ def candidates(names=None, vehicle=None):
         pname = eff.primary
         par = eff.parameter(pname)
         lo, hi = SEARCH.get(name, {}).get(pname, tuple(par.range))
+        side = (sides or {}).get(name, 0)
+        if side and name in OWN_SIDE_RANGES and OWN_SIDE_RANGES[name][0] == pname:
+            lo, hi = OWN_SIDE_RANGES[name][1] if side > 0 else OWN_SIDE_RANGES[name][2]
         if vp is not None:
             vlo, vhi, _ = eff.vehicle_ranges(vp)[pname]
             lo, hi = max(lo, vlo), min(hi, vhi)
@@ -1400,8 +1416,45 @@ def _phase_runs(model: TruckModel, effects, T: float, seeds, executor=None) -> l
     return [model.run(effects, 0.0, T, sd) for sd in seeds]
 
 
+def own_signature_stats(model: TruckModel, sig: Signals, runs, seeds) -> list:
+    """The own-signature statistic (:func:`diagnosis.compare.stroke_velocity_skewness`) of
+    noise-free records ``runs`` made on road phases ``seeds``, each with its sensor noise."""
+    from diagnosis.compare import stroke_velocity_skewness
+
+    return [stroke_velocity_skewness(Signals(sig.time, model.add_noise(r, sd), dict(sig.units),
+                                             sig.speed, {})) for r, sd in zip(runs, seeds)]
+
+
+def own_side_record(model: TruckModel, sig: Signals, seed: int, executor=None):
+    """Before the ranking: the nominal model on the own signature's road phases
+    (:func:`signature_seeds`), the statistic of each record and of the measurement, and the
+    side (:func:`diagnosis.verdict.own_side`) each effect of :data:`OWN_SIDE_RANGES` is
+    searched on.  Returns ``(record, nominal_runs, seconds)``; ``record`` is None (and no run
+    made) without :data:`OWN_SIDE` or a suspension displacement channel.  The runs are
+    handed on to :func:`own_signature_record` (the same phases), so the step costs nothing
+    where a damper wins."""
+    from diagnosis.compare import stroke_velocity_skewness
+    from diagnosis.verdict import own_side
+
+    m = stroke_velocity_skewness(sig)
+    if not OWN_SIDE or m is None:
+        return None, None, None
+    t = _time.perf_counter()
+    T = sig.time.size / sig.fs
+    seeds = signature_seeds(seed)
+    runs = _phase_runs(model, {}, T, seeds, executor)
+    nominal = own_signature_stats(model, sig, runs, seeds)
+    side = own_side(m, nominal)
+    rec = {"statistic": "stroke_velocity_skewness", "measured": float(m),
+           "nominal": [float(v) if v is not None else None for v in nominal],
+           "sides": {name: side for name in OWN_SIDE_RANGES},
+           "ranges": {name: (list(r[1]) if side > 0 else list(r[2])) if side else None
+                      for name, r in OWN_SIDE_RANGES.items()}}
+    return rec, runs, _time.perf_counter() - t
+
+
 def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, executor=None,
-                         model_runs=None):
+                         model_runs=None, nominal_runs=None):
     """The ``signature_own`` record of a winner whose effect has a signature of its own
     (:data:`diagnosis.verdict.OWN_SIGNATURE`), and the seconds taken; ``(None, None)`` for
     any other effect.  The nominal model and the calibrated candidate each drive the road
@@ -1409,7 +1462,8 @@ def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, exec
     both, so the comparison is paired), with sensor noise, and the statistic
     (:func:`diagnosis.compare.stroke_velocity_skewness`) is taken of every record and of the
     measurement.  ``model_runs``: the candidate's records on those phases where already made
-    (:func:`_model_signature` returns them), else they are run here."""
+    (:func:`_model_signature` returns them), else they are run here; ``nominal_runs`` the
+    nominal model's (:func:`own_side_record`), likewise."""
     from diagnosis.compare import stroke_velocity_skewness
     from diagnosis.verdict import OWN_SIGNATURE, own_signature
 
@@ -1420,14 +1474,11 @@ def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, exec
     seeds = signature_seeds(seed)
     if model_runs is None:
         model_runs = _phase_runs(model, entry.effects, T, seeds, executor)
-    nominal_runs = _phase_runs(model, {}, T, seeds, executor)
-
-    def stat(runs):
-        return [stroke_velocity_skewness(Signals(sig.time, model.add_noise(r, sd), dict(sig.units),
-                                                 sig.speed, {})) for r, sd in zip(runs, seeds)]
-
-    rec = own_signature(entry.effect, stroke_velocity_skewness(sig), stat(nominal_runs),
-                        stat(model_runs))
+    if nominal_runs is None:
+        nominal_runs = _phase_runs(model, {}, T, seeds, executor)
+    rec = own_signature(entry.effect, stroke_velocity_skewness(sig),
+                        own_signature_stats(model, sig, nominal_runs, seeds),
+                        own_signature_stats(model, sig, model_runs, seeds))
     return rec, _time.perf_counter() - t
 
 
@@ -1521,7 +1572,6 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     # which
     t = _time.perf_counter()
     names = list(effects) if effects else (list(QUICK_EFFECTS) if quick else None)
-    cands = candidates(names, veh)
     kw = dict(QUICK_BUDGET) if quick else dict(BUDGET)
     kw.update(settings or {})
     folds = int(kw.pop("folds", 1))
@@ -1530,11 +1580,28 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     # pairs are calibrated per fold and not combined: one fold tries them by default
     kw["pairs"] = bool(kw.get("pairs", True)) and folds == 1
     fit, simulate = Fit(model), Simulate(model)
+    ex = process_pool(workers) if workers and workers > 1 else None
+    # the side of 1 a damper asymmetry is searched on, from its own signature (OWN_SIDE)
+    wants_side = any(n in OWN_SIDE_RANGES for n in (names or OWN_SIDE_RANGES))
+    try:
+        side_rec, nominal_own_runs, t_side = (own_side_record(model, sig, seed, ex) if wants_side
+                                              else (None, None, None))
+    except BaseException:
+        if ex is not None:
+            ex.shutdown()
+        raise
+    if t_side is not None:
+        timing["own_side_s"] = t_side
+    cands = candidates(names, veh, sides=(side_rec or {}).get("sides"))
+    for name, rng in ((side_rec or {}).get("ranges") or {}).items():
+        if rng is not None and any(c.name == name for c in cands):
+            progress(f"{name}: searched over {rng[0]:g}-{rng[1]:g} (the measured stroke-velocity "
+                     f"skewness {side_rec['measured']:+.2f} against the nominal model's "
+                     f"{np.mean([v for v in side_rec['nominal'] if v is not None]):+.2f})")
     progress(f"ranking {len(cands)} candidate effect(s) on {len(calib)} calibration + "
              f"{len(held)} held-out windows ({workers} worker(s)"
              + (", two folds: then the roles swapped)" if folds == 2 else ")"))
     splits = [(calib, held, seed)] + ([(held, calib, seed + 1)] if folds == 2 else [])
-    ex = process_pool(workers) if workers and workers > 1 else None
     try:
         rankings = [rank_effects(cands, fit, simulate, c, h, seed=sd, executor=ex,
                                  progress=progress, delay=delay_term(model),
@@ -1553,7 +1620,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         if t_sig is not None:
             timing["signature_s"] = t_sig
         # an effect the transmissibility cannot test (damper asymmetry): its own signature
-        sig_own, t_own = own_signature_record(model, sig, ranking.winner, seed, ex, model_runs=runs_w)
+        sig_own, t_own = own_signature_record(model, sig, ranking.winner, seed, ex, model_runs=runs_w,
+                                              nominal_runs=nominal_own_runs)
         if t_own is not None:
             timing["signature_own_s"] = t_own
         # a rival within noise of the winner's gap: its signature too, so the verdict can
@@ -1595,6 +1663,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         "noise_std": model.noise, "wheelbase_m": wheelbase, "quick": bool(quick), "seed": int(seed),
         "workers": int(workers), "candidates": [c.name for c in cands],
         "search_ranges": search_ranges(cands),
+        "own_side": side_rec,
         "signature_method": SIGNATURE_METHOD,
         "ranking_settings": {**{k: v for k, v in kw.items()}, "folds": folds},
         "timing": {k: round(v, 2) for k, v in timing.items()},

@@ -475,6 +475,12 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                      + " the effect out; the verdict uses it instead of the transmissibility.")
         if D.get("edge"):
             L.append(f" Calibrated at the edge of the search range: {', '.join(D['edge'])}.")
+        side = (summary.get("meta") or {}).get("own_side") or {}
+        for name, rng in (side.get("ranges") or {}).items():
+            if rng is not None and name in (summary.get("meta") or {}).get("candidates", []):
+                L.append(f" {name} was searched over {rng[0]:g}-{rng[1]:g} only: the measured "
+                         f"stroke-velocity skewness ({side['measured']:+.2f}) lies beyond the "
+                         f"nominal model's on the same road phases on that side.")
         L.append("")
     st = summary.get("localization_settings")
     if st:

@@ -334,6 +334,21 @@ def own_signature_agrees(record: Mapping, z_nominal: float = OWN_Z_NOMINAL,
             "nominal_mean": float(a.mean()), "model_mean": float(b.mean()), "measured": float(m)}
 
 
+def own_side(measured, nominal, z_nominal: float = OWN_Z_NOMINAL) -> int:
+    """Which way the measurement's own-signature statistic departs from the nominal model's:
+    +1 (-1) where it lies at least ``z_nominal`` prediction sd above (below) the mean of the
+    nominal model's values on the signature's road phases, else 0.  The prediction sd is
+    ``max(sd, OWN_SD_FLOOR) sqrt(1 + 1/n)`` with the nominal values' own sd (n - 1 degrees of
+    freedom) -- the candidate's values do not exist yet when the search range is set
+    (``diagnosis.pipeline.OWN_SIDE``)."""
+    a = np.asarray([v for v in (nominal or []) if v is not None], float)
+    if measured is None or a.size < 2 or not math.isfinite(float(measured)):
+        return 0
+    sd = max(float(a.std(ddof=1)), OWN_SD_FLOOR) * math.sqrt(1.0 + 1.0 / a.size)
+    z = (float(measured) - float(a.mean())) / sd
+    return 1 if z >= z_nominal else (-1 if z <= -z_nominal else 0)
+
+
 def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_MAX,
                         level: float = SIGNATURE_NULL_LEVEL) -> float:
     """The largest mean z^2 at which a signature agrees on this drive.

@@ -311,3 +311,81 @@ def test_edge_calibration_whose_own_signature_disagrees_stays_unexplained():
     d = decide(_edge_summary(own))
     assert d["verdict"] == "unexplained" and d["edge"] == ["damper_asymmetry.ratio"]
     assert "edge of its search range" in d["reason"]
+
+
+# ------------------------------------------- the side of 1 a damper asymmetry is searched on
+def test_own_side_numbers():
+    from diagnosis.verdict import own_side
+
+    sd = max(float(np.std(NOM, ddof=1)), OWN_SD_FLOOR) * math.sqrt(1 + 1 / 5)
+    assert own_side(OWN_Z_NOMINAL * sd * 1.01, NOM) == 1
+    assert own_side(-OWN_Z_NOMINAL * sd * 1.01, NOM) == -1
+    assert own_side(OWN_Z_NOMINAL * sd * 0.99, NOM) == 0          # not beyond the threshold
+    assert own_side(None, NOM) == 0 and own_side(0.5, [0.1]) == 0
+
+
+def test_candidates_searched_on_the_side_the_signature_shows():
+    from diagnosis.pipeline import OWN_SIDE_RANGES, SEARCH, candidates
+
+    def rng(sides):
+        c = next(c for c in candidates(["damper_asymmetry", "payload"], sides=sides)
+                 if c.name == "damper_asymmetry")
+        return c.params[0].lo, c.params[0].hi
+
+    assert rng(None) == SEARCH["damper_asymmetry"]["ratio"] == rng({"damper_asymmetry": 0})
+    assert rng({"damper_asymmetry": 1}) == OWN_SIDE_RANGES["damper_asymmetry"][1] == (1.0, 8.0)
+    assert rng({"damper_asymmetry": -1}) == OWN_SIDE_RANGES["damper_asymmetry"][2] == (0.2, 1.0)
+    # a side for another effect changes nothing
+    pay = [c for c in candidates(["payload"], sides={"payload": 1})][0].params[0]
+    assert (pay.lo, pay.hi) == SEARCH["payload"]["mass"]
+
+
+class _TruckConventionModel(_StandInModel):
+    """The stand-in with eroad's sign of the suspension displacement (compression positive:
+    a rebound-heavy damper skews the stroke velocity positive, as on the truck below)."""
+
+    def run(self, effects, t0, t1, seed):
+        return {k: -v for k, v in super().run(effects, t0, t1, seed).items()}
+
+
+def test_pipeline_side_from_the_nominal_models_phases_and_reused_by_the_record():
+    from diagnosis.pipeline import own_side_record
+
+    # measured: the oscillator with a rebound-heavy damper (ratio 3) in the truck's sign
+    meas = _signals({"susp_disp_1L": -_oscillator_stroke(3.0, T=120.0, seed=99)})
+    model = _TruckConventionModel()
+    rec, runs, dt = own_side_record(model, meas, seed=0)
+    assert dt >= 0 and len(runs) == 5 and len(rec["nominal"]) == 5
+    assert sorted(sd for eff, sd in model.calls) == [1, 2, 3, 4, 5]     # the signature's phases
+    assert not any(eff for eff, sd in model.calls)                      # the nominal model only
+    assert rec["sides"]["damper_asymmetry"] == 1                         # above the nominal's
+    assert rec["ranges"]["damper_asymmetry"] == [1.0, 8.0]
+    # the record after the ranking reuses the nominal runs: only the candidate is driven
+    model.calls.clear()
+    rec2, _ = own_signature_record(model, meas,
+                                   _Entry("damper_asymmetry", {"damper_asymmetry": {"ratio": 3.0}}),
+                                   seed=0, nominal_runs=runs)
+    assert rec2["nominal"] == rec["nominal"]
+    assert all(eff for eff, sd in model.calls) and len(model.calls) == 5
+    # a compression-heavy damper: the other side; a symmetric one: the whole range
+    low = _signals({"susp_disp_1L": -_oscillator_stroke(1 / 3.0, T=120.0, seed=99)})
+    assert own_side_record(_TruckConventionModel(), low, seed=0)[0]["ranges"]["damper_asymmetry"] \
+        == [0.2, 1.0]
+    sym = _signals({"susp_disp_1L": -_oscillator_stroke(1.0, T=120.0, seed=99)})
+    rec3, _, _ = own_side_record(_TruckConventionModel(), sym, seed=0)
+    assert rec3["sides"]["damper_asymmetry"] == 0 and rec3["ranges"]["damper_asymmetry"] is None
+
+
+def test_truck_sign_of_the_skewness_follows_the_ratio(tmp_path):
+    # OWN_SIDE_RANGES maps a skewness above the nominal model's to ratio > 1: that is the
+    # truck's sign (eroad's own Exudyn truck, 30 s null-scenario drives, seed 5: ratio 3 gave
+    # +0.24, 1/3 gave -0.13; a symmetric damper's road-phase scatter is about 0.05)
+    from diagnosis.pipeline import load_measured
+    from drives.synth import synth_command
+
+    sk = {}
+    for r in (1 / 3.0, 3.0):
+        out = tmp_path / f"r{r:.2f}"
+        synth_command(scenario="null", seed=5, effects=[f"damper_asymmetry.ratio={r!r}"], out=out)
+        sk[r] = stroke_velocity_skewness(load_measured(out)[1])
+    assert sk[3.0] > 0.1 and sk[1 / 3.0] < -0.05
