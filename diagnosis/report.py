@@ -404,6 +404,35 @@ def _fmt(v, f="{:.3g}"):
     return "-" if v is None else f.format(v)
 
 
+def _calibrated_value(summary: Mapping, verdict: str) -> str:
+    """", calibrated <param> = <value> <unit>" of a named effect's searched parameters (the
+    value the ranking holds, and each fold's where there are two); "" for none/unexplained."""
+    entry = next((e for e in summary.get("ranking") or [] if e.get("effect") == verdict), None)
+    ranges = (summary.get("meta") or {}).get("search_ranges") or {}
+    if entry is None:
+        return ""
+    from vehicles.effects import EFFECTS
+
+    parts = []
+    for eff, pars in ranges.items():
+        if eff not in (entry.get("parameters") or {}):
+            continue
+        for p in pars:
+            val = entry["parameters"][eff].get(p)
+            if val is None:
+                continue
+            try:
+                unit = EFFECTS[eff].parameter(p).unit
+            except (KeyError, AttributeError, ValueError):
+                unit = ""
+            unit = "" if unit in ("", "-") else f" {unit}"
+            folds = [f.get(eff, {}).get(p) for f in entry.get("parameters_per_fold") or []]
+            fold_txt = (" (folds " + ", ".join(f"{x:.4g}" for x in folds if x is not None) + ")"
+                        if len(folds) > 1 else "")
+            parts.append(f"{eff}.{p} = {val:.4g}{unit}{fold_txt}")
+    return (", calibrated " + "; ".join(parts)) if parts else ""
+
+
 def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
     """The readable report (Markdown) from a summary and figure file names."""
     L = []
@@ -415,7 +444,8 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
     L.append("")
     L.append("## Verdict\n")
     v = summary["verdict"]
-    L.append(f"**{v}** (confidence: {summary['verdict_confidence']}). {summary['verdict_reason']}.\n")
+    L.append(f"**{v}** (confidence: {summary['verdict_confidence']})"
+             + _calibrated_value(summary, v) + f". {summary['verdict_reason']}.\n")
     H = summary.get("how_far")
     if H and H["is_verdict"]:
         L.append(f"Held-out gap {H['heldout_gap_before']:.3g} -> {H['heldout_gap_after']:.3g}: "

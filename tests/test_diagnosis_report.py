@@ -159,3 +159,21 @@ def test_segments_in_record_time(tmp_path, results, monkeypatch):
     # a summary written before the field existed reads from 0
     del s["meta"]["record_t0_s"]
     assert segment_label(s, "S1") == "S1 (0.0-30.0 s)"
+
+
+def test_verdict_line_gives_the_calibrated_value_with_its_unit_and_folds():
+    # a named effect's value is what a user acts on: it stands in the verdict line, with the
+    # library's unit and each fold's value (hand-made summary: the numbers are chosen)
+    from diagnosis.report import render_markdown
+
+    entry = {"effect": "bump_stop", "accepted": True,
+             "parameters": {"bump_stop": {"gap": 0.00512, "stiffness": 2e6, "smoothing": 0.002}},
+             "parameters_per_fold": [{"bump_stop": {"gap": 0.00608}}, {"bump_stop": {"gap": 0.00431}}]}
+    s = {"verdict": "bump_stop", "verdict_confidence": "clear", "verdict_reason": "r",
+         "ranking": [entry], "meta": {"search_ranges": {"bump_stop": {"gap": [0.001, 0.08, True]}}}}
+    line = next(ln for ln in render_markdown(s, {}).splitlines() if ln.startswith("**bump_stop**"))
+    assert "calibrated bump_stop.gap = 0.00512 m (folds 0.00608, 0.00431)" in line
+    assert "stiffness" not in line                       # fixed parameters are not calibrated
+    s.update(verdict="unexplained", verdict_confidence="none")
+    line = next(ln for ln in render_markdown(s, {}).splitlines() if ln.startswith("**unexplained**"))
+    assert "calibrated" not in line
