@@ -163,17 +163,21 @@ def test_segments_in_record_time(tmp_path, results, monkeypatch):
 
 def test_verdict_line_gives_the_calibrated_value_with_its_unit_and_folds():
     # a named effect's value is what a user acts on: it stands in the verdict line, with the
-    # library's unit and each fold's value (hand-made summary: the numbers are chosen)
-    from diagnosis.report import render_markdown
+    # library's unit and each fold's value (hand-made entry: the numbers are chosen)
+    from pathlib import Path
+
+    from diagnosis.report import _calibrated_value, render_markdown
 
     entry = {"effect": "bump_stop", "accepted": True,
              "parameters": {"bump_stop": {"gap": 0.00512, "stiffness": 2e6, "smoothing": 0.002}},
              "parameters_per_fold": [{"bump_stop": {"gap": 0.00608}}, {"bump_stop": {"gap": 0.00431}}]}
-    s = {"verdict": "bump_stop", "verdict_confidence": "clear", "verdict_reason": "r",
-         "ranking": [entry], "meta": {"search_ranges": {"bump_stop": {"gap": [0.001, 0.08, True]}}}}
-    line = next(ln for ln in render_markdown(s, {}).splitlines() if ln.startswith("**bump_stop**"))
-    assert "calibrated bump_stop.gap = 0.00512 m (folds 0.00608, 0.00431)" in line
-    assert "stiffness" not in line                       # fixed parameters are not calibrated
-    s.update(verdict="unexplained", verdict_confidence="none")
-    line = next(ln for ln in render_markdown(s, {}).splitlines() if ln.startswith("**unexplained**"))
-    assert "calibrated" not in line
+    s = {"ranking": [entry], "meta": {"search_ranges": {"bump_stop": {"gap": [0.001, 0.08, True]}}}}
+    txt = _calibrated_value(s, "bump_stop")
+    assert txt == ", calibrated bump_stop.gap = 0.00512 m (folds 0.00608, 0.00431)"
+    assert _calibrated_value(s, "unexplained") == "" and _calibrated_value(s, "none") == ""
+    # a saved summary of a blind drive (damper asymmetry 3.32, named at 3.42): in the verdict line
+    saved = Path(__file__).resolve().parents[1] / "results" / "diagnosis_blind" / \
+        "20261127-own-signature-fresh-40" / "nominal" / "case005-summary.json"
+    line = render_markdown(json.loads(saved.read_text()), {}).splitlines()
+    line = next(ln for ln in line if ln.startswith("**damper_asymmetry**"))
+    assert "calibrated damper_asymmetry.ratio = 3.42" in line and "(folds 3.742, 3.127)" in line
