@@ -670,37 +670,28 @@ class DelayTerm(WindowTerm):
 
 
 @dataclass
-class ShapeTerm(WindowTerm):
-    """Amplitude-distribution mismatch as a term of the gap: the skewness of the suspension
-    displacements (road-independent in expectation: a Gaussian road through a linear model
-    gives symmetric responses, so only a nonlinear effect, a bump stop or an asymmetric
-    damper, skews them; band powers cannot see it, and a linear rival such as a payload
-    error can mimic such an effect's spectra).  Per window, ``rho_j`` is the mean over
-    ``channels`` of ``g1_sim - g1_meas`` (the sample skewness; the channels of one vehicle
-    skew the same way).  The rest as :class:`WindowTerm`.
-    """
+class _ChannelTerm(WindowTerm):
+    """A per-channel statistic of each window (``_per_channel(signals) -> {channel: value}``)
+    compared as ``rho_j`` = the mean over ``channels`` of ``stat_sim - stat_meas`` (base of
+    :class:`ShapeTerm` and :class:`StrokeVelocityTerm`: the channels of one vehicle move the
+    same way)."""
 
     channels: list
 
-    #: skewness of a 7.5 s window scatters by about 0.1-0.3 between road phases; a floor
-    #: keeps a window whose nominal seeds happen to agree from dominating
-    SIGMA_FLOOR = 0.02
-    label = "shape"
+    def _per_channel(self, signals) -> dict:   # pragma: no cover - abstract
+        raise NotImplementedError
 
     def stats(self, windows) -> np.ndarray:
-        """Sample skewness per window and channel, (W, C) array."""
+        """The statistic per window and channel, (W, C) array (NaN where a channel is absent
+        or the statistic undefined)."""
         from .signals import as_signals
 
         out = np.full((len(windows), len(self.channels)), np.nan)
         for j, w in enumerate(windows):
-            ch = as_signals(w).channels
+            val = self._per_channel(as_signals(w))
             for k, c in enumerate(self.channels):
-                if c in ch:
-                    x = np.asarray(ch[c], float)
-                    x = x - x.mean()
-                    m2 = float(np.mean(x * x))
-                    if m2 > 0:
-                        out[j, k] = float(np.mean(x ** 3)) / m2 ** 1.5
+                if c in val:
+                    out[j, k] = val[c]
         return out
 
     @staticmethod
@@ -711,7 +702,37 @@ class ShapeTerm(WindowTerm):
 
 
 @dataclass
-class StrokeVelocityTerm(WindowTerm):
+class ShapeTerm(_ChannelTerm):
+    """Amplitude-distribution mismatch as a term of the gap: the skewness of the suspension
+    displacements (road-independent in expectation: a Gaussian road through a linear model
+    gives symmetric responses, so only a nonlinear effect, a bump stop or an asymmetric
+    damper, skews them; band powers cannot see it, and a linear rival such as a payload
+    error can mimic such an effect's spectra).  Per window, ``rho_j`` is the mean over
+    ``channels`` of ``g1_sim - g1_meas`` (the sample skewness; the channels of one vehicle
+    skew the same way).  The rest as :class:`WindowTerm`.
+    """
+
+    #: skewness of a 7.5 s window scatters by about 0.1-0.3 between road phases; a floor
+    #: keeps a window whose nominal seeds happen to agree from dominating
+    SIGMA_FLOOR = 0.02
+    label = "shape"
+
+    def _per_channel(self, signals) -> dict:
+        """Sample skewness of each of ``channels`` present with a nonzero variance."""
+        out = {}
+        for c in self.channels:
+            if c not in signals.channels:
+                continue
+            x = np.asarray(signals.channels[c], float)
+            x = x - x.mean()
+            m2 = float(np.mean(x * x))
+            if m2 > 0:
+                out[c] = float(np.mean(x ** 3)) / m2 ** 1.5
+        return out
+
+
+@dataclass
+class StrokeVelocityTerm(_ChannelTerm):
     """Stroke-velocity asymmetry as a term of the gap: the skewness of the suspension stroke
     velocity of every ``channels`` (suspension displacement) per window
     (:func:`diagnosis.compare.stroke_velocity_skewness_per_channel`).  Road-independent in
@@ -723,32 +744,15 @@ class StrokeVelocityTerm(WindowTerm):
     over the channels of ``skew_sim - skew_meas``; the rest as :class:`WindowTerm`.
     """
 
-    channels: list
-
     #: the per-window skewness of a 7.5 s window scatters by about 0.1 between road phases
     #: (development drives); the floor as :class:`ShapeTerm`'s
     SIGMA_FLOOR = 0.02
     label = "stroke velocity"
 
-    def stats(self, windows) -> np.ndarray:
-        """Stroke-velocity skewness per window and channel, (W, C) array."""
+    def _per_channel(self, signals) -> dict:
         from .compare import stroke_velocity_skewness_per_channel
-        from .signals import as_signals
 
-        out = np.full((len(windows), len(self.channels)), np.nan)
-        for j, w in enumerate(windows):
-            sig = as_signals(w)
-            sk = stroke_velocity_skewness_per_channel(sig)
-            for k, c in enumerate(self.channels):
-                if c in sk:
-                    out[j, k] = sk[c]
-        return out
-
-    @staticmethod
-    def _rho(ls: np.ndarray, lm: np.ndarray) -> np.ndarray:
-        with np.errstate(all="ignore"), warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            return np.nanmean(ls - lm, axis=1)
+        return stroke_velocity_skewness_per_channel(signals)
 
 
 @dataclass
