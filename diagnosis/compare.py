@@ -1124,14 +1124,11 @@ def distribution_shape(measured, simulated, *, channels: Sequence[str] | None = 
 STROKE_VELOCITY_BAND = (0.5, 15.0)
 
 
-def stroke_velocity_skewness_per_channel(signals, band: tuple[float, float] = STROKE_VELOCITY_BAND,
-                                         quantity: str = "susp_disp") -> dict:
-    """Skewness of the suspension stroke velocity of every ``quantity`` channel (name ->
-    value; a constant channel is left out): each channel band-passed (``band``,
-    fourth-order Butterworth, zero phase), differentiated, and its skewness
-    ``E[v^3] / E[v^2]^1.5`` taken (the biased estimator, ``scipy.stats.skew``).  The
-    station mean is :func:`stroke_velocity_skewness`; the per-window term of the gap is
-    :class:`diagnosis.which.StrokeVelocityTerm`."""
+def stroke_velocities(signals, band: tuple[float, float] = STROKE_VELOCITY_BAND,
+                      quantity: str = "susp_disp") -> dict:
+    """The suspension stroke velocity of every ``quantity`` channel (name -> array; a
+    constant channel is left out): each channel band-passed (``band``, fourth-order
+    Butterworth, zero phase) and differentiated."""
     from scipy.signal import butter, sosfiltfilt
 
     sig = as_signals(signals)
@@ -1144,8 +1141,46 @@ def stroke_velocity_skewness_per_channel(signals, band: tuple[float, float] = ST
     for c in names:
         v = np.gradient(sosfiltfilt(sos, np.asarray(sig.channels[c], float)), 1.0 / sig.fs)
         if np.ptp(v) > 0:
-            out[c] = float(stats.skew(v))
+            out[c] = v
     return out
+
+
+def l_skewness(x) -> float:
+    """Sample L-skewness ``t3 = l3 / l2`` (Hosking 1990, J. R. Stat. Soc. B 52: 105-124).
+
+    From the unbiased probability-weighted moments of the ordered sample ``x_(1..n)``:
+    ``b_r = n^-1 sum_i [(i-1)...(i-r)] / [(n-1)...(n-r)] x_(i)``, ``l2 = 2 b1 - b0``,
+    ``l3 = 6 b2 - 6 b1 + b0``.  Bounded (``|t3| < 1``) and linear in the order statistics,
+    so a few extreme samples move it far less than the third moment: 0 for a symmetric
+    distribution, 1/3 for the exponential, 0.1699 for the Gumbel."""
+    x = np.sort(np.asarray(x, float).ravel())
+    n = x.size
+    if n < 3:
+        raise EroadInputError(f"l_skewness: needs at least 3 samples, got {n}")
+    i = np.arange(n, dtype=float)
+    b0 = x.mean()
+    b1 = float(np.sum(i * x)) / (n * (n - 1))
+    b2 = float(np.sum(i * (i - 1) * x)) / (n * (n - 1) * (n - 2))
+    l2 = 2.0 * b1 - b0
+    if not l2 > 0:
+        raise EroadInputError("l_skewness: the sample is constant")
+    return float((6.0 * b2 - 6.0 * b1 + b0) / l2)
+
+
+def stroke_velocity_skewness_per_channel(signals, band: tuple[float, float] = STROKE_VELOCITY_BAND,
+                                         quantity: str = "susp_disp") -> dict:
+    """Skewness ``E[v^3] / E[v^2]^1.5`` (the biased estimator, ``scipy.stats.skew``) of the
+    stroke velocity (:func:`stroke_velocities`) of every ``quantity`` channel.  The station
+    mean is :func:`stroke_velocity_skewness`; the per-window term of the gap is
+    :class:`diagnosis.which.StrokeVelocityTerm`."""
+    return {c: float(stats.skew(v)) for c, v in stroke_velocities(signals, band, quantity).items()}
+
+
+def stroke_velocity_l_skewness_per_channel(signals, band: tuple[float, float] = STROKE_VELOCITY_BAND,
+                                           quantity: str = "susp_disp") -> dict:
+    """L-skewness (:func:`l_skewness`) of the stroke velocity (:func:`stroke_velocities`) of
+    every ``quantity`` channel; the station mean is :func:`stroke_velocity_l_skewness`."""
+    return {c: l_skewness(v) for c, v in stroke_velocities(signals, band, quantity).items()}
 
 
 def stroke_velocity_skewness(signals, band: tuple[float, float] = STROKE_VELOCITY_BAND,
@@ -1161,10 +1196,38 @@ def stroke_velocity_skewness(signals, band: tuple[float, float] = STROKE_VELOCIT
     asymmetry ratio; symmetric nonlinearities (Coulomb friction) leave it near 0.  Measured
     (development drives, our truck, 30 s): nominal model -0.16..+0.18 per station,
     station mean within +-0.05 over road phases; a damper asymmetry 2.94 gave +0.24..+0.53
-    per station (mean +0.35).  None where the record has no such channel.
+    per station (mean +0.35).  None where the record has no such channel.  The own signature
+    uses :func:`stroke_velocity_l_skewness` since 2026-11-28: a third moment is carried by
+    a few extreme samples (a rough patch, a tyre lifting off), so its road-phase scatter is
+    heavy-tailed (docs/diagnosis.md, "The own signature's statistic").
     """
     out = stroke_velocity_skewness_per_channel(signals, band, quantity)
     return float(np.mean(list(out.values()))) if out else None
+
+
+def stroke_velocity_l_skewness(signals, band: tuple[float, float] = STROKE_VELOCITY_BAND,
+                               quantity: str = "susp_disp") -> float | None:
+    """L-skewness of the suspension stroke velocity, averaged over the wheel stations
+    (:func:`stroke_velocity_l_skewness_per_channel`): the damper asymmetry's own signature.
+
+    Same reasoning as :func:`stroke_velocity_skewness` (0 for a linear truck on a Gaussian
+    road; gain and offset drop out; the sign follows ``ratio - 1``), with a statistic that
+    is linear in the ordered samples.  Measured on the 182 saved blind drives of five sets
+    (seeds 36-73; 5 road phases of the nominal model each, prediction sd as
+    :func:`diagnosis.verdict.own_side` with its floors): the sd over road phases spans
+    0.0023-0.0085 (5-95 %) against 0.024-0.22 for the skewness; on our truck the ten damper
+    drives depart from the nominal model by 4.4-12.3 prediction sd (skewness 3.5-7.5) while
+    the 100 drives without a damper asymmetry choose a side 2 times (skewness 7); on the
+    independent truck 7 of 72 drives (skewness 18).  None where the record has no such
+    channel.
+    """
+    out = stroke_velocity_l_skewness_per_channel(signals, band, quantity)
+    return float(np.mean(list(out.values()))) if out else None
+
+
+#: the own signatures' statistics by name (``diagnosis.verdict.OWN_SIGNATURE``'s values)
+OWN_STATISTICS = {"stroke_velocity_skewness": stroke_velocity_skewness,
+                  "stroke_velocity_l_skewness": stroke_velocity_l_skewness}
 
 
 def sprague_geers(measured: np.ndarray, computed: np.ndarray) -> tuple[float, float, float]:

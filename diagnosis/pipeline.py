@@ -130,8 +130,9 @@ SEARCH = {
 }
 #: an effect with an own signature (``diagnosis.verdict.OWN_SIGNATURE``) is searched on the
 #: side of its neutral value that the measured signature shows (:func:`own_side_record`):
-#: a damper asymmetry's stroke-velocity skewness gives the sign of ``ratio - 1`` without the
-#: road (skewness 0 for a linear truck on a Gaussian road), while the band gap can be flat or
+#: a damper asymmetry's stroke-velocity asymmetry (its own signature's statistic, the
+#: L-skewness since 2026-11-28) gives the sign of ``ratio - 1`` without the road (0 for a
+#: linear truck on a Gaussian road), while the band gap can be flat or
 #: two-basined across 1 -- blind cases with a damper asymmetry of 3.85, 3.8 and 2.12 had one
 #: fold calibrate at 0.2, 0.3 and 0.64 (diag seeds 67 case 5, 20261127-fresh-40 case 5,
 #: 20261125-nominal-liftoff-seed19 case 4).  Only where the measurement lies at least
@@ -1416,13 +1417,25 @@ def _phase_runs(model: TruckModel, effects, T: float, seeds, executor=None) -> l
     return [model.run(effects, 0.0, T, sd) for sd in seeds]
 
 
-def own_signature_stats(model: TruckModel, sig: Signals, runs, seeds) -> list:
-    """The own-signature statistic (:func:`diagnosis.compare.stroke_velocity_skewness`) of
-    noise-free records ``runs`` made on road phases ``seeds``, each with its sensor noise."""
-    from diagnosis.compare import stroke_velocity_skewness
+def own_signature_stats(model: TruckModel, sig: Signals, runs, seeds, statistic: str) -> list:
+    """The own-signature statistic ``statistic`` (a key of
+    :data:`diagnosis.compare.OWN_STATISTICS`) of noise-free records ``runs`` made on road
+    phases ``seeds``, each with its sensor noise."""
+    from diagnosis.compare import OWN_STATISTICS
 
-    return [stroke_velocity_skewness(Signals(sig.time, model.add_noise(r, sd), dict(sig.units),
-                                             sig.speed, {})) for r, sd in zip(runs, seeds)]
+    fn = OWN_STATISTICS[statistic]
+    return [fn(Signals(sig.time, model.add_noise(r, sd), dict(sig.units), sig.speed, {}))
+            for r, sd in zip(runs, seeds)]
+
+
+def _own_side_statistic() -> str:
+    """The one own-signature statistic of the effects in :data:`OWN_SIDE_RANGES`."""
+    from diagnosis.verdict import OWN_SIGNATURE
+
+    stats_ = {OWN_SIGNATURE[name] for name in OWN_SIDE_RANGES}
+    if len(stats_) != 1:
+        raise ValueError(f"OWN_SIDE_RANGES mixes own-signature statistics: {sorted(stats_)}")
+    return stats_.pop()
 
 
 def own_side_record(model: TruckModel, sig: Signals, seed: int, executor=None):
@@ -1433,19 +1446,20 @@ def own_side_record(model: TruckModel, sig: Signals, seed: int, executor=None):
     made) without :data:`OWN_SIDE` or a suspension displacement channel.  The runs are
     handed on to :func:`own_signature_record` (the same phases), so the step costs nothing
     where a damper wins."""
-    from diagnosis.compare import stroke_velocity_skewness
+    from diagnosis.compare import OWN_STATISTICS
     from diagnosis.verdict import own_side
 
-    m = stroke_velocity_skewness(sig)
+    stat = _own_side_statistic()
+    m = OWN_STATISTICS[stat](sig)
     if not OWN_SIDE or m is None:
         return None, None, None
     t = _time.perf_counter()
     T = sig.time.size / sig.fs
     seeds = signature_seeds(seed)
     runs = _phase_runs(model, {}, T, seeds, executor)
-    nominal = own_signature_stats(model, sig, runs, seeds)
-    side = own_side(m, nominal)
-    rec = {"statistic": "stroke_velocity_skewness", "measured": float(m),
+    nominal = own_signature_stats(model, sig, runs, seeds, stat)
+    side = own_side(m, nominal, statistic=stat)
+    rec = {"statistic": stat, "measured": float(m),
            "nominal": [float(v) if v is not None else None for v in nominal],
            "sides": {name: side for name in OWN_SIDE_RANGES},
            "ranges": {name: (list(r[1]) if side > 0 else list(r[2])) if side else None
@@ -1460,15 +1474,16 @@ def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, exec
     any other effect.  The nominal model and the calibrated candidate each drive the road
     phases of the transmissibility signature (:func:`signature_seeds`: the same roads for
     both, so the comparison is paired), with sensor noise, and the statistic
-    (:func:`diagnosis.compare.stroke_velocity_skewness`) is taken of every record and of the
-    measurement.  ``model_runs``: the candidate's records on those phases where already made
+    (``OWN_SIGNATURE[effect]``, :data:`diagnosis.compare.OWN_STATISTICS`) is taken of every
+    record and of the measurement.  ``model_runs``: the candidate's records on those phases where already made
     (:func:`_model_signature` returns them), else they are run here; ``nominal_runs`` the
     nominal model's (:func:`own_side_record`), likewise."""
-    from diagnosis.compare import stroke_velocity_skewness
+    from diagnosis.compare import OWN_STATISTICS
     from diagnosis.verdict import OWN_SIGNATURE, own_signature
 
     if entry is None or entry.effect not in OWN_SIGNATURE:
         return None, None
+    stat = OWN_SIGNATURE[entry.effect]
     t = _time.perf_counter()
     T = sig.time.size / sig.fs
     seeds = signature_seeds(seed)
@@ -1476,9 +1491,9 @@ def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, exec
         model_runs = _phase_runs(model, entry.effects, T, seeds, executor)
     if nominal_runs is None:
         nominal_runs = _phase_runs(model, {}, T, seeds, executor)
-    rec = own_signature(entry.effect, stroke_velocity_skewness(sig),
-                        own_signature_stats(model, sig, nominal_runs, seeds),
-                        own_signature_stats(model, sig, model_runs, seeds))
+    rec = own_signature(entry.effect, OWN_STATISTICS[stat](sig),
+                        own_signature_stats(model, sig, nominal_runs, seeds, stat),
+                        own_signature_stats(model, sig, model_runs, seeds, stat))
     return rec, _time.perf_counter() - t
 
 
@@ -1525,7 +1540,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     """
     from diagnosis.compare import distribution_shape, transmissibility
     from diagnosis.report import write_report
-    from diagnosis.verdict import SIGNATURE_METHOD, search_ranges
+    from diagnosis.verdict import OWN_STATISTIC_NAMES, SIGNATURE_METHOD, search_ranges
     from diagnosis.which import combine_folds, rank_effects
     from diagnosis.where import localize
     from eroad.threads import process_pool
@@ -1595,9 +1610,10 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     cands = candidates(names, veh, sides=(side_rec or {}).get("sides"))
     for name, rng in ((side_rec or {}).get("ranges") or {}).items():
         if rng is not None and any(c.name == name for c in cands):
-            progress(f"{name}: searched over {rng[0]:g}-{rng[1]:g} (the measured stroke-velocity "
-                     f"skewness {side_rec['measured']:+.2f} against the nominal model's "
-                     f"{np.mean([v for v in side_rec['nominal'] if v is not None]):+.2f})")
+            progress(f"{name}: searched over {rng[0]:g}-{rng[1]:g} (the measured "
+                     f"{OWN_STATISTIC_NAMES.get(side_rec['statistic'], side_rec['statistic'])} "
+                     f"{side_rec['measured']:+.3f} against the nominal model's "
+                     f"{np.mean([v for v in side_rec['nominal'] if v is not None]):+.3f})")
     progress(f"ranking {len(cands)} candidate effect(s) on {len(calib)} calibration + "
              f"{len(held)} held-out windows ({workers} worker(s)"
              + (", two folds: then the roles swapped)" if folds == 2 else ")"))

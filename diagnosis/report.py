@@ -38,11 +38,16 @@ from matplotlib.figure import Figure
 
 from eroad.errors import EroadInputError
 
-from .verdict import decide
+from .verdict import OWN_STATISTIC_NAMES, decide
 
 __all__ = ["build_summary", "write_report", "plot_heatmap", "plot_segments",
            "plot_transmissibility", "plot_ranking", "plot_shrink_bands", "render_markdown",
            "jsonable"]
+
+
+def _own_name(statistic) -> str:
+    """How the report names an own-signature statistic (older summaries: the skewness)."""
+    return OWN_STATISTIC_NAMES.get(statistic or "stroke_velocity_skewness", str(statistic))
 
 
 def jsonable(obj: Any) -> Any:
@@ -495,12 +500,12 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                      + ".")
         O = D.get("signature_own")
         if O and O.get("agrees") is not None:
-            L.append(f" Its own signature, the stroke-velocity skewness (mean over the wheel "
-                     f"stations; 0 for a linear truck on a Gaussian road; sd over road phases "
-                     f"{O['sd']:.2g}): measured {O['measured']:+.2f}, nominal model "
-                     f"{O['nominal_mean']:+.2f} (z {O['z_nominal']:+.1f}), with "
+            L.append(f" Its own signature, the {_own_name(O.get('statistic'))} (mean over the "
+                     f"wheel stations; 0 for a linear truck on a Gaussian road; sd over road "
+                     f"phases {O['sd']:.2g}): measured {O['measured']:+.3f}, nominal model "
+                     f"{O['nominal_mean']:+.3f} (z {O['z_nominal']:+.1f}), with "
                      f"{R['model'] if R['model'] != 'nominal' else 'the effect'} "
-                     f"{O['model_mean']:+.2f} (z {O['z_model']:+.1f}); it "
+                     f"{O['model_mean']:+.3f} (z {O['z_model']:+.1f}); it "
                      + ("singles" if O["agrees"] else "does not single")
                      + " the effect out; the verdict uses it instead of the transmissibility.")
         if D.get("edge"):
@@ -509,7 +514,7 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
         for name, rng in (side.get("ranges") or {}).items():
             if rng is not None and name in (summary.get("meta") or {}).get("candidates", []):
                 L.append(f" {name} was searched over {rng[0]:g}-{rng[1]:g} only: the measured "
-                         f"stroke-velocity skewness ({side['measured']:+.2f}) lies beyond the "
+                         f"{_own_name(side.get('statistic'))} ({side['measured']:+.3f}) lies beyond the "
                          f"nominal model's on the same road phases on that side.")
         L.append("")
     st = summary.get("localization_settings")

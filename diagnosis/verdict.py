@@ -47,7 +47,7 @@ Vocabulary
        gap with a rival is broken by the transmissibility (:func:`decide`,
        ``SIGNATURE_TIE_BREAK``).  An effect listed in ``OWN_SIGNATURE`` (damper asymmetry) is
        tested on its own road-independent signature instead of the transmissibility it barely
-       moves (:func:`own_signature_agrees`: the stroke-velocity skewness), both ways.  ``identified``
+       moves (:func:`own_signature_agrees`: the stroke-velocity L-skewness), both ways.  ``identified``
     (in the result) is True when the named effect's identity and value are not in doubt
     (no close rival, no range edge) even if a remainder keeps it from "clear": the
     closed loop (``diagnosis.closed_loop``) corrects with such an effect.  The front-to-rear delay and the amplitude distribution
@@ -264,7 +264,23 @@ TIE_RATIO = 0.7
 #: distribution does not support (damper asymmetry was named on drives without it, e.g.
 #: case 13 of 20261127-fresh-40).  Added 2026-11-27 after reading those sets; checked blind
 #: afterwards (docs/diagnosis.md, "Own signature").
-OWN_SIGNATURE = {"damper_asymmetry": "stroke_velocity_skewness"}
+#: The statistic was the moment skewness until 2026-11-28 and is the L-skewness since
+#: (:func:`diagnosis.compare.stroke_velocity_l_skewness`; docs/diagnosis.md, "The own
+#: signature's statistic"): the third moment's road-phase scatter is heavy-tailed (one
+#: rough patch or a tyre lifting off carries it), which refused both damper drives of the
+#: seed-73 blind check with the right model (z 3.1 and 4.8).  Saved summaries keep the
+#: statistic they were made with (``signature_own["statistic"]``) and are re-decided with it.
+OWN_SIGNATURE = {"damper_asymmetry": "stroke_velocity_l_skewness"}
+#: how reports name each statistic, and what it is
+OWN_STATISTIC_NAMES = {"stroke_velocity_skewness": "stroke-velocity skewness",
+                       "stroke_velocity_l_skewness": "stroke-velocity L-skewness"}
+OWN_STATISTIC_MEASURES = {
+    "stroke_velocity_skewness": (
+        "mean over the wheel stations of the skewness of the suspension stroke velocity "
+        "(suspension displacement band-passed 0.5-15 Hz, differentiated)"),
+    "stroke_velocity_l_skewness": (
+        "mean over the wheel stations of the L-skewness (Hosking 1990) of the suspension stroke "
+        "velocity (suspension displacement band-passed 0.5-15 Hz, differentiated)")}
 #: is the own signature used (else every effect takes the transmissibility test)
 SIGNATURE_OWN = True
 #: positive evidence asked of an own signature: the nominal model's value lies at least
@@ -279,10 +295,16 @@ SIGNATURE_OWN = True
 OWN_Z_NOMINAL = 2.5
 OWN_Z_MODEL = 3.0
 OWN_SHARE = 0.5
-#: smallest sd of the statistic over road phases [-]: with 2 x 5 records the pooled sd can
-#: come out small by chance; 0.03 is below every value measured on the development drives
-#: (0.011-0.23 for the station mean over 3 road phases, mostly 0.05)
-OWN_SD_FLOOR = 0.03
+#: smallest sd of each statistic over road phases [-]: with 2 x 5 records the pooled sd can
+#: come out small by chance.  Skewness: 0.03, below every value measured on the development
+#: drives (0.011-0.23 for the station mean over 3 road phases, mostly 0.05).  L-skewness:
+#: 0.003, chosen on our truck's 100 saved blind drives without a damper asymmetry (nominal
+#: model's sd over 5 phases 0.0023-0.0085, 5-95 %; 0.003 takes a side on 2 of them, 0.002
+#: on 3, no damper drive's departure falls below 4.4 sd with either); checked on the
+#: independent truck's 72 (7 sides at 0.003).
+OWN_SD_FLOORS = {"stroke_velocity_skewness": 0.03, "stroke_velocity_l_skewness": 0.003}
+#: the floor of the statistic in use
+OWN_SD_FLOOR = OWN_SD_FLOORS[OWN_SIGNATURE["damper_asymmetry"]]
 #: a winner calibrated at an edge of its search range is still named (``ambiguous``, never
 #: ``clear`` nor ``identified``, the value a bound) when its own road-independent signature
 #: agrees: the edge rule withholds a name because a value pinned at the range's end may
@@ -301,9 +323,8 @@ def own_signature(effect: str, measured: float, nominal, model) -> dict:
     statistic and the nominal and candidate models' values on the same road phases (lists,
     one per phase).  The verdict (:func:`own_signature_agrees`) derives everything else, so
     a saved summary can be re-decided with other thresholds."""
-    return {"effect": effect, "statistic": OWN_SIGNATURE[effect],
-            "measure": ("mean over the wheel stations of the skewness of the suspension stroke "
-                        "velocity (suspension displacement band-passed 0.5-15 Hz, differentiated)"),
+    stat = OWN_SIGNATURE[effect]
+    return {"effect": effect, "statistic": stat, "measure": OWN_STATISTIC_MEASURES[stat],
             "measured": _f(measured), "nominal": [_f(v) for v in nominal],
             "model": [_f(v) for v in model]}
 
@@ -313,7 +334,8 @@ def own_signature_agrees(record: Mapping, z_nominal: float = OWN_Z_NOMINAL,
     """Does the own signature give positive evidence for the candidate?
 
     With ``m`` the measured value, ``a`` and ``b`` the nominal and candidate models' values
-    over the same road phases (n each) and ``s`` their pooled sd (at least ``OWN_SD_FLOOR``),
+    over the same road phases (n each) and ``s`` their pooled sd (at least the statistic's
+    ``OWN_SD_FLOORS`` entry),
     the prediction sd of one measurement against a model's mean is ``s sqrt(1 + 1/n)``:
     ``z0 = (m - mean a) / sd``, ``z1 = (m - mean b) / sd``.  Agrees when ``|z0| >= z_nominal``
     (the nominal model does not make what was measured), ``|z1| <= z_model`` (the candidate
@@ -326,25 +348,29 @@ def own_signature_agrees(record: Mapping, z_nominal: float = OWN_Z_NOMINAL,
         return {"agrees": None}
     pooled = math.sqrt((((a - a.mean()) ** 2).sum() + ((b - b.mean()) ** 2).sum())
                        / (a.size + b.size - 2))
-    sd = max(pooled, OWN_SD_FLOOR) * math.sqrt(1.0 + 2.0 / (a.size + b.size))
+    floor = OWN_SD_FLOORS.get(record.get("statistic"), OWN_SD_FLOOR)
+    sd = max(pooled, floor) * math.sqrt(1.0 + 2.0 / (a.size + b.size))
     d0, d1 = float(m) - float(a.mean()), float(m) - float(b.mean())
     z0, z1 = d0 / sd, d1 / sd
     ok = bool(abs(z0) >= z_nominal and abs(z1) <= z_model and abs(d1) <= (1.0 - share) * abs(d0))
     return {"agrees": ok, "z_nominal": z0, "z_model": z1, "sd": sd,
-            "nominal_mean": float(a.mean()), "model_mean": float(b.mean()), "measured": float(m)}
+            "nominal_mean": float(a.mean()), "model_mean": float(b.mean()), "measured": float(m),
+            "statistic": record.get("statistic")}
 
 
-def own_side(measured, nominal, z_nominal: float = OWN_Z_NOMINAL) -> int:
+def own_side(measured, nominal, z_nominal: float = OWN_Z_NOMINAL, statistic: str | None = None) -> int:
     """Which way the measurement's own-signature statistic departs from the nominal model's:
     +1 (-1) where it lies at least ``z_nominal`` prediction sd above (below) the mean of the
     nominal model's values on the signature's road phases, else 0.  The prediction sd is
-    ``max(sd, OWN_SD_FLOOR) sqrt(1 + 1/n)`` with the nominal values' own sd (n - 1 degrees of
-    freedom) -- the candidate's values do not exist yet when the search range is set
+    ``max(sd, floor) sqrt(1 + 1/n)`` with the nominal values' own sd (n - 1 degrees of
+    freedom) and the floor of ``statistic`` (``OWN_SD_FLOORS``; default the one in use) --
+    the candidate's values do not exist yet when the search range is set
     (``diagnosis.pipeline.OWN_SIDE``)."""
     a = np.asarray([v for v in (nominal or []) if v is not None], float)
     if measured is None or a.size < 2 or not math.isfinite(float(measured)):
         return 0
-    sd = max(float(a.std(ddof=1)), OWN_SD_FLOOR) * math.sqrt(1.0 + 1.0 / a.size)
+    floor = OWN_SD_FLOORS.get(statistic, OWN_SD_FLOOR)
+    sd = max(float(a.std(ddof=1)), floor) * math.sqrt(1.0 + 1.0 / a.size)
     z = (float(measured) - float(a.mean())) / sd
     return 1 if z >= z_nominal else (-1 if z <= -z_nominal else 0)
 
@@ -538,8 +564,9 @@ class _SignatureTest:
 
 
 #: how the reason names the two signatures
-_WHAT_OWN = ("stroke-velocity skewness (its own signature; the transmissibility, which it "
-             "barely moves, is not used)")
+def _what_own(own_res: Mapping) -> str:
+    name = OWN_STATISTIC_NAMES.get(own_res.get("statistic"), "own-signature statistic")
+    return f"{name} (its own signature; the transmissibility, which it barely moves, is not used)"
 
 
 def _what(sig_method: str) -> str:
@@ -674,10 +701,10 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                      f"(at least {share_min:.0%} asked)" if math.isfinite(share) else
                      "its share of the gap above a correct model's is undefined")
     if agrees is False and own_res is not None:
-        short.append(f"its {_WHAT_OWN} does not single it out: measured "
-                     f"{own_res['measured']:+.2f}, nominal model {own_res['nominal_mean']:+.2f} "
+        short.append(f"its {_what_own(own_res)} does not single it out: measured "
+                     f"{own_res['measured']:+.3f}, nominal model {own_res['nominal_mean']:+.3f} "
                      f"(z {own_res['z_nominal']:+.1f}, at least {OWN_Z_NOMINAL:g} asked), "
-                     f"{win['effect']} {own_res['model_mean']:+.2f} (z {own_res['z_model']:+.1f}, "
+                     f"{win['effect']} {own_res['model_mean']:+.3f} (z {own_res['z_model']:+.1f}, "
                      f"at most {OWN_Z_MODEL:g} asked)")
     elif agrees is False:
         short.append(f"its {what} still disagrees with the measurement "
@@ -714,9 +741,9 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                   f"; its {what} agrees with the measurement")
                + remainder)
     if own_res is not None:
-        reason += (f"; its {_WHAT_OWN} agrees: measured {own_res['measured']:+.2f}, nominal model "
-                   f"{own_res['nominal_mean']:+.2f} (z {own_res['z_nominal']:+.1f}), {win['effect']} "
-                   f"{own_res['model_mean']:+.2f} (z {own_res['z_model']:+.1f})")
+        reason += (f"; its {_what_own(own_res)} agrees: measured {own_res['measured']:+.3f}, "
+                   f"nominal model {own_res['nominal_mean']:+.3f} (z {own_res['z_nominal']:+.1f}), "
+                   f"{win['effect']} {own_res['model_mean']:+.3f} (z {own_res['z_model']:+.1f})")
     caveats = []
     if remainder and conf == "clear":
         caveats.append(" (so not 'clear')")

@@ -1,26 +1,31 @@
-"""The damper asymmetry's own signature: the stroke-velocity skewness, and how the verdict uses it.
+"""The damper asymmetry's own signature: the stroke-velocity L-skewness (the moment skewness
+before 2026-11-28), and how the verdict uses it.
 
 References that do not come from eroad's truck:
+* the L-skewness against its closed form for three distributions (uniform 0, Gumbel
+  0.1699, exponential 1/3; Hosking 1990, Table 1) and against its definition as a
+  U-statistic over all triples of a small sample, written out here;
 * a linear oscillator on a Gaussian base motion answers with Gaussian velocities (skewness
-  0 whatever its stiffness and damping);
+  and L-skewness 0 whatever its stiffness and damping);
 * a one-mass oscillator whose damper is stiffer in rebound (extension) than in compression
   moves slowly while extending and fast while compressing: with extension positive, the
   stroke velocity is negatively skewed, and the sign turns with the asymmetry (simulated
   here with its own few lines of semi-implicit Euler, not with eroad's models);
-* skewness is a standardised moment: a sensor gain and offset drop out, a sign flip of the
-  channel flips it.
+* both statistics are standardised: a sensor gain and offset drop out, a sign flip of the
+  channel flips them.
 The verdict rules are checked on summaries built by hand (numbers chosen, not simulated).
 """
+import itertools
 import math
 
 import numpy as np
 import pytest
 
-from diagnosis.compare import stroke_velocity_skewness
+from diagnosis.compare import l_skewness, stroke_velocity_l_skewness, stroke_velocity_skewness
 from diagnosis.pipeline import own_signature_record
 from diagnosis.signals import Signals
-from diagnosis.verdict import (OWN_SD_FLOOR, OWN_Z_MODEL, OWN_Z_NOMINAL, decide, own_signature,
-                               own_signature_agrees)
+from diagnosis.verdict import (OWN_SD_FLOOR, OWN_SIGNATURE, OWN_Z_MODEL, OWN_Z_NOMINAL, decide,
+                               own_signature, own_signature_agrees)
 
 FS = 200.0
 
@@ -68,37 +73,87 @@ def _signals(channels):
     return Signals(t, channels, {c: "m" for c in channels}, np.full(n, 15.0), {})
 
 
-def test_gaussian_strokes_have_no_skewness():
-    # 8 stations x 600 s of a band-limited Gaussian displacement: the skewness of a
-    # velocity correlated over about 0.1 s has sd about sqrt(6 / 6000) = 0.03 per station,
-    # 0.011 for the mean of 8; 0.05 is 4.5 sd
+def test_l_skewness_closed_forms():
+    # 200 000 samples: the sampling sd of t3 is about 0.002 (uniform) to 0.003
+    # (exponential); 0.01 is 3 sd or more
+    rng = np.random.default_rng(7)
+    n = 200_000
+    assert l_skewness(rng.uniform(size=n)) == pytest.approx(0.0, abs=0.01)
+    assert l_skewness(rng.gumbel(size=n)) == pytest.approx(0.1699, abs=0.01)
+    assert l_skewness(rng.exponential(size=n)) == pytest.approx(1.0 / 3.0, abs=0.01)
+    assert l_skewness(-rng.exponential(size=n)) == pytest.approx(-1.0 / 3.0, abs=0.01)
+    with pytest.raises(Exception):
+        l_skewness([1.0, 1.0, 1.0])
+
+
+def test_l_skewness_is_its_u_statistic_definition():
+    # Hosking (1990) eq. 2.3 as sample statistics: l2 = C(n,2)^-1 sum_{i<j} (x_j - x_i) / 2,
+    # l3 = C(n,3)^-1 sum_{i<j<k} (x_k - 2 x_j + x_i) / 3 over the ordered sample; the
+    # probability-weighted-moment formula must give the same number (rounding only)
+    x = np.sort(np.random.default_rng(3).lognormal(size=14))
+    l2 = np.mean([(b - a) / 2 for a, b in itertools.combinations(x, 2)])
+    l3 = np.mean([(c - 2 * b + a) / 3 for a, b, c in itertools.combinations(x, 3)])
+    assert l_skewness(x) == pytest.approx(l3 / l2, rel=1e-12)
+    assert l_skewness(x[::-1]) == pytest.approx(l3 / l2, rel=1e-12)      # order does not matter
+
+
+# per statistic: the bound on a Gaussian record's value, and on the oscillator's values
+# (one station of 235 s; measured over base-motion seeds 3-7: skewness ratio 1 -0.02..+0.00,
+# ratio 3 -0.15..-0.11, ratio 1/3 +0.11..+0.13, sd about 0.02; L-skewness ratio 1
+# -0.0034..+0.0022, ratio 3 -0.026..-0.016, ratio 1/3 +0.018..+0.022, sd about 0.0025):
+# bounds 3 sd or more from the values
+STATS = {
+    # 8 stations x 600 s of a band-limited Gaussian displacement: the skewness of a velocity
+    # correlated over about 0.1 s has sd about sqrt(6 / 6000) = 0.03 per station, 0.011 for
+    # the mean of 8, so 0.05 is 4.5 sd; the L-skewness's mean of 8 scattered by 0.0007 over
+    # 10 such records, so 0.003 is 4.4 sd
+    "skewness": (stroke_velocity_skewness, 0.05, 0.06, 0.08),
+    "l_skewness": (stroke_velocity_l_skewness, 0.003, 0.009, 0.01),
+}
+
+
+@pytest.mark.parametrize("name", sorted(STATS))
+def test_gaussian_strokes_have_no_skewness(name):
+    fn, gauss_bound, _, _ = STATS[name]
     rng = np.random.default_rng(11)
     n = int(600 * FS)
     ch = {f"susp_disp_{a}{s}": 0.01 * _band_gauss(n, 0.5, 12.0, FS, rng)
           for a in range(1, 5) for s in "LR"}
-    assert abs(stroke_velocity_skewness(_signals(ch))) < 0.05
+    assert abs(fn(_signals(ch))) < gauss_bound
 
 
-def test_linear_oscillator_symmetric_asymmetric_damper_skewed_by_its_sign():
-    s1 = stroke_velocity_skewness(_signals({"susp_disp_1L": _oscillator_stroke(1.0)}))
-    s_reb = stroke_velocity_skewness(_signals({"susp_disp_1L": _oscillator_stroke(3.0)}))
-    s_com = stroke_velocity_skewness(_signals({"susp_disp_1L": _oscillator_stroke(1 / 3.0)}))
-    # one station of 235 s; measured over base-motion seeds 3, 4, 5: ratio 1 -0.02..+0.00,
-    # ratio 3 -0.15..-0.11, ratio 1/3 +0.11..+0.13 (sd about 0.02): bounds 3 sd or more away
-    assert abs(s1) < 0.06
-    assert s_reb < -0.08 and s_com > 0.08
+@pytest.mark.parametrize("name", sorted(STATS))
+def test_linear_oscillator_symmetric_asymmetric_damper_skewed_by_its_sign(name):
+    fn, _, sym_bound, asym_bound = STATS[name]
+    s1 = fn(_signals({"susp_disp_1L": _oscillator_stroke(1.0)}))
+    s_reb = fn(_signals({"susp_disp_1L": _oscillator_stroke(3.0)}))
+    s_com = fn(_signals({"susp_disp_1L": _oscillator_stroke(1 / 3.0)}))
+    assert abs(s1) < sym_bound
+    assert s_reb < -asym_bound and s_com > asym_bound
     # mirror image: the same asymmetry the other way round, about the same size
     assert abs(s_reb + s_com) < 0.5 * abs(s_reb)
 
 
-def test_gain_and_offset_drop_out_and_sign_flips():
+@pytest.mark.parametrize("name", sorted(STATS))
+def test_gain_and_offset_drop_out_and_sign_flips(name):
+    fn = STATS[name][0]
     s = _oscillator_stroke(3.0)
-    a = stroke_velocity_skewness(_signals({"susp_disp_1L": s}))
-    b = stroke_velocity_skewness(_signals({"susp_disp_1L": 1000.0 * s + 12.0}))
-    c = stroke_velocity_skewness(_signals({"susp_disp_1L": -s}))
+    a = fn(_signals({"susp_disp_1L": s}))
+    b = fn(_signals({"susp_disp_1L": 1000.0 * s + 12.0}))
+    c = fn(_signals({"susp_disp_1L": -s}))
     assert b == pytest.approx(a, rel=1e-9, abs=1e-12)
     assert c == pytest.approx(-a, rel=1e-9, abs=1e-12)
-    assert stroke_velocity_skewness(_signals({"body_acc_1L": s})) is None
+    assert fn(_signals({"body_acc_1L": s})) is None
+
+
+def test_the_own_signature_is_the_l_skewness():
+    # the statistic the records carry, and the one the pipeline computes, are one
+    from diagnosis.compare import OWN_STATISTICS
+
+    assert OWN_SIGNATURE["damper_asymmetry"] == "stroke_velocity_l_skewness"
+    assert OWN_STATISTICS[OWN_SIGNATURE["damper_asymmetry"]] is stroke_velocity_l_skewness
+    assert own_signature("damper_asymmetry", 0.0, [0.0], [0.0])["statistic"] == \
+        "stroke_velocity_l_skewness"
 
 
 # --- the verdict -------------------------------------------------------------------------
@@ -138,6 +193,21 @@ def test_own_signature_numbers():
     r = own_signature_agrees(own_signature("damper_asymmetry", 0.1, [0.0] * 5, [0.1] * 5))
     assert r["sd"] == pytest.approx(OWN_SD_FLOOR * math.sqrt(1.2), rel=1e-12)
     assert own_signature_agrees({"measured": None, "nominal": NOM, "model": DAMP})["agrees"] is None
+
+
+def test_the_floor_follows_the_records_statistic():
+    # a summary saved with the moment skewness is re-decided with that statistic's floor
+    # (0.03), a new one with the L-skewness's (0.003): identical records, different sd
+    from diagnosis.verdict import OWN_SD_FLOORS
+
+    new = own_signature("damper_asymmetry", 0.01, [0.0] * 5, [0.01] * 5)
+    old = dict(new, statistic="stroke_velocity_skewness")
+    assert own_signature_agrees(new)["sd"] == pytest.approx(
+        OWN_SD_FLOORS["stroke_velocity_l_skewness"] * math.sqrt(1.2), rel=1e-12)
+    assert own_signature_agrees(old)["sd"] == pytest.approx(
+        OWN_SD_FLOORS["stroke_velocity_skewness"] * math.sqrt(1.2), rel=1e-12)
+    assert own_signature_agrees(new)["agrees"] is True          # 0.01 is 3 floors from 0
+    assert own_signature_agrees(old)["agrees"] is False         # and a third of one
 
 
 def test_own_signature_names_a_damper_the_transmissibility_cannot_test():
@@ -195,7 +265,7 @@ class _StandInModel:
     def run(self, effects, t0, t1, seed):
         self.calls.append((bool(effects), seed))
         ratio = effects["damper_asymmetry"]["ratio"] if effects else 1.0
-        s = _oscillator_stroke(ratio, T=120.0, seed=seed)
+        s = _oscillator_stroke(ratio, T=240.0, seed=seed)
         return {"susp_disp_1L": s}
 
     def add_noise(self, rec, seed):
@@ -204,16 +274,19 @@ class _StandInModel:
 
 
 def test_pipeline_records_nominal_and_candidate_on_the_same_road_phases():
-    # 115 s records: ratio 3 gave -0.16..-0.06 over base-motion seeds 1-15 (sd 0.03); the
-    # measurement is seed 99's, the records those of seeds 1-5 (the signature's phases)
-    meas = _signals({"susp_disp_1L": _oscillator_stroke(3.0, T=120.0, seed=99)})
+    # 235 s records, L-skewness: ratio 3 gave -0.026..-0.016 over base-motion seeds 1-10 (sd
+    # 0.0036), ratio 1 -0.0034..+0.0029 (sd 0.0022, so 0.001 for a mean of 5: 0.004 is 4 of
+    # those); the measurement is seed 99's (-0.021), the records those of seeds 1-5 (the
+    # signature's phases).  At 115 s the L-skewness of one station was too noisy for the
+    # nominal test (z -2.4)
+    meas = _signals({"susp_disp_1L": _oscillator_stroke(3.0, T=240.0, seed=99)})
     model = _StandInModel()
     rec, dt = own_signature_record(model, meas,
                                    _Entry("damper_asymmetry", {"damper_asymmetry": {"ratio": 3.0}}),
                                    seed=0)
     assert rec["effect"] == "damper_asymmetry" and dt >= 0
     assert len(rec["nominal"]) == len(rec["model"]) == 5
-    assert abs(np.mean(rec["nominal"])) < 0.06 and np.mean(rec["model"]) < -0.08
+    assert abs(np.mean(rec["nominal"])) < 0.004 and np.mean(rec["model"]) < -0.012
     # paired: both models on the signature's road phases seed + 1 .. seed + 5
     assert sorted(sd for eff, sd in model.calls if not eff) == [1, 2, 3, 4, 5]
     assert sorted(sd for eff, sd in model.calls if eff) == [1, 2, 3, 4, 5]
@@ -352,7 +425,7 @@ def test_pipeline_side_from_the_nominal_models_phases_and_reused_by_the_record()
     from diagnosis.pipeline import own_side_record
 
     # measured: the oscillator with a rebound-heavy damper (ratio 3) in the truck's sign
-    meas = _signals({"susp_disp_1L": -_oscillator_stroke(3.0, T=120.0, seed=99)})
+    meas = _signals({"susp_disp_1L": -_oscillator_stroke(3.0, T=240.0, seed=99)})
     model = _TruckConventionModel()
     rec, runs, dt = own_side_record(model, meas, seed=0)
     assert dt >= 0 and len(runs) == 5 and len(rec["nominal"]) == 5
@@ -368,18 +441,19 @@ def test_pipeline_side_from_the_nominal_models_phases_and_reused_by_the_record()
     assert rec2["nominal"] == rec["nominal"]
     assert all(eff for eff, sd in model.calls) and len(model.calls) == 5
     # a compression-heavy damper: the other side; a symmetric one: the whole range
-    low = _signals({"susp_disp_1L": -_oscillator_stroke(1 / 3.0, T=120.0, seed=99)})
+    low = _signals({"susp_disp_1L": -_oscillator_stroke(1 / 3.0, T=240.0, seed=99)})
     assert own_side_record(_TruckConventionModel(), low, seed=0)[0]["ranges"]["damper_asymmetry"] \
         == [0.2, 1.0]
-    sym = _signals({"susp_disp_1L": -_oscillator_stroke(1.0, T=120.0, seed=99)})
+    sym = _signals({"susp_disp_1L": -_oscillator_stroke(1.0, T=240.0, seed=99)})
     rec3, _, _ = own_side_record(_TruckConventionModel(), sym, seed=0)
     assert rec3["sides"]["damper_asymmetry"] == 0 and rec3["ranges"]["damper_asymmetry"] is None
 
 
 def test_truck_sign_of_the_skewness_follows_the_ratio(tmp_path):
-    # OWN_SIDE_RANGES maps a skewness above the nominal model's to ratio > 1: that is the
-    # truck's sign (eroad's own Exudyn truck, 30 s null-scenario drives, seed 5: ratio 3 gave
-    # +0.24, 1/3 gave -0.13; a symmetric damper's road-phase scatter is about 0.05)
+    # OWN_SIDE_RANGES maps a statistic above the nominal model's to ratio > 1: that is the
+    # truck's sign (eroad's own Exudyn truck, 30 s null-scenario drives, seed 5: L-skewness
+    # ratio 3 +0.033, 1/3 -0.025, 1 +0.004; a symmetric damper's road-phase scatter about
+    # 0.005 -- the skewness gave +0.24 and -0.13 with a scatter about 0.05)
     from diagnosis.pipeline import load_measured
     from drives.synth import synth_command
 
@@ -387,5 +461,5 @@ def test_truck_sign_of_the_skewness_follows_the_ratio(tmp_path):
     for r in (1 / 3.0, 3.0):
         out = tmp_path / f"r{r:.2f}"
         synth_command(scenario="null", seed=5, effects=[f"damper_asymmetry.ratio={r!r}"], out=out)
-        sk[r] = stroke_velocity_skewness(load_measured(out)[1])
-    assert sk[3.0] > 0.1 and sk[1 / 3.0] < -0.05
+        sk[r] = stroke_velocity_l_skewness(load_measured(out)[1])
+    assert sk[3.0] > 0.015 and sk[1 / 3.0] < -0.01
