@@ -1197,7 +1197,7 @@ def stroke_velocity_skewness(signals, band: tuple[float, float] = STROKE_VELOCIT
     (development drives, our truck, 30 s): nominal model -0.16..+0.18 per station,
     station mean within +-0.05 over road phases; a damper asymmetry 2.94 gave +0.24..+0.53
     per station (mean +0.35).  None where the record has no such channel.  The own signature
-    uses :func:`stroke_velocity_l_skewness` since 2026-11-28: a third moment is carried by
+    uses :func:`stroke_velocity_l_skewness` since 2026-11-27: a third moment is carried by
     a few extreme samples (a rough patch, a tyre lifting off), so its road-phase scatter is
     heavy-tailed (docs/diagnosis.md, "The own signature's statistic").
     """

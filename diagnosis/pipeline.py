@@ -131,7 +131,7 @@ SEARCH = {
 #: an effect with an own signature (``diagnosis.verdict.OWN_SIGNATURE``) is searched on the
 #: side of its neutral value that the measured signature shows (:func:`own_side_record`):
 #: a damper asymmetry's stroke-velocity asymmetry (its own signature's statistic, the
-#: L-skewness since 2026-11-28) gives the sign of ``ratio - 1`` without the road (0 for a
+#: L-skewness since 2026-11-27) gives the sign of ``ratio - 1`` without the road (0 for a
 #: linear truck on a Gaussian road), while the band gap can be flat or
 #: two-basined across 1 -- blind cases with a damper asymmetry of 3.85, 3.8 and 2.12 had one
 #: fold calibrate at 0.2, 0.3 and 0.64 (diag seeds 67 case 5, 20261127-fresh-40 case 5,

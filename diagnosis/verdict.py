@@ -264,7 +264,7 @@ TIE_RATIO = 0.7
 #: distribution does not support (damper asymmetry was named on drives without it, e.g.
 #: case 13 of 20261127-fresh-40).  Added 2026-11-27 after reading those sets; checked blind
 #: afterwards (docs/diagnosis.md, "Own signature").
-#: The statistic was the moment skewness until 2026-11-28 and is the L-skewness since
+#: The statistic was the moment skewness until 2026-11-27 and is the L-skewness since
 #: (:func:`diagnosis.compare.stroke_velocity_l_skewness`; docs/diagnosis.md, "The own
 #: signature's statistic"): the third moment's road-phase scatter is heavy-tailed (one
 #: rough patch or a tyre lifting off carries it), which refused both damper drives of the

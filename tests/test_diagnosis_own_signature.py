@@ -1,5 +1,5 @@
 """The damper asymmetry's own signature: the stroke-velocity L-skewness (the moment skewness
-before 2026-11-28), and how the verdict uses it.
+before 2026-11-27), and how the verdict uses it.
 
 References that do not come from eroad's truck:
 * the L-skewness against its closed form for three distributions (uniform 0, Gumbel
