@@ -53,22 +53,36 @@ def oracle_fits(dataset: Path, truth: dict, track_y=(-0.9, 0.9)) -> list:
     spectrum than the exact profile it drove over, so these errors bound what the
     inversion can reach on the same segments.
     """
-    from roadlib.metrics import fit_iso_psd, profile_psd
     from roadlib.surface import RoadSurface
 
     road = RoadSurface.load(Path(dataset) / "truth" / "road.npz")
     out = []
     for s in truth["segments"]:
-        x = np.arange(s["x_start"], s["x_end"], road.dx)
-        if x.size < 64:
-            out.append(None)
-            continue
-        z = road.tracks(list(track_y), x).T
-        est = profile_psd(z, road.dx, nperseg=x.size)
-        fit = fit_iso_psd(est, band=(s["nmin"], s["nmax"]))
-        out.append({"Gq": float(fit.Gd_n0), "w": float(fit.w),
-                    "dlnGq": abs(math.log(fit.Gd_n0 / s["Gq_n0"])), "dw": abs(fit.w - s["w"])})
+        fit = _true_road_fit(road, s["x_start"], s["x_end"], (s["nmin"], s["nmax"]), track_y)
+        out.append(None if fit is None else
+                   dict(fit, dlnGq=abs(math.log(fit["Gq"] / s["Gq_n0"])), dw=abs(fit["w"] - s["w"])))
     return out
+
+
+def _true_road_fit(road, x0: float, x1: float, band, track_y):
+    """The one-slope Whittle fit (``Gq``, ``w``) of the true road's ``track_y`` tracks over
+    [x0, x1) m in ``band`` (one full-length Hann periodogram per track); None for fewer than
+    64 samples."""
+    from roadlib.metrics import fit_iso_psd, profile_psd
+
+    x = np.arange(x0, x1, road.dx)
+    if x.size < 64:
+        return None
+    z = road.tracks(list(track_y), x).T
+    fit = fit_iso_psd(profile_psd(z, road.dx, nperseg=x.size), band=band)
+    return {"Gq": float(fit.Gd_n0), "w": float(fit.w)}
+
+
+def _most_overlapping(seg: dict, fit: list) -> dict:
+    """The fit segment that overlaps the true segment ``seg`` longest in time (the one it is
+    scored with)."""
+    ov = [max(0.0, min(seg["t_end"], f["t_end"]) - max(seg["t_start"], f["t_start"])) for f in fit]
+    return fit[int(np.argmax(ov))]
 
 
 def oracle_on_fit_windows(dataset: Path, truth: dict, summary: dict, track_y=(-0.9, 0.9)) -> list:
@@ -78,23 +92,14 @@ def oracle_on_fit_windows(dataset: Path, truth: dict, summary: dict, track_y=(-0
     must be on the truth's reference axle (:func:`on_truth_axle`).  Against
     :func:`oracle_fits` (the true segment's own window) this separates what the fit's
     boundaries cost from what the response-based estimate costs on the same windows."""
-    from roadlib.metrics import fit_iso_psd, profile_psd
     from roadlib.surface import RoadSurface
 
     road = RoadSurface.load(Path(dataset) / "truth" / "road.npz")
-    fit = summary["segments"]
     out = []
     for s in truth["segments"]:
-        ov = [max(0.0, min(s["t_end"], f["t_end"]) - max(s["t_start"], f["t_start"])) for f in fit]
-        f = fit[int(np.argmax(ov))]
+        f = _most_overlapping(s, summary["segments"])
         x0, x1 = reference_axle_x(truth, [f["t_start"], f["t_end"]])
-        x = np.arange(max(float(x0), 0.0), float(x1), road.dx)
-        if x.size < 64:
-            out.append(None)
-            continue
-        z = road.tracks(list(track_y), x).T
-        o = fit_iso_psd(profile_psd(z, road.dx, nperseg=x.size), band=(s["nmin"], s["nmax"]))
-        out.append({"Gq": float(o.Gd_n0), "w": float(o.w)})
+        out.append(_true_road_fit(road, max(float(x0), 0.0), float(x1), (s["nmin"], s["nmax"]), track_y))
     return out
 
 
@@ -264,8 +269,7 @@ def score_case(truth: dict, summary: dict) -> dict:
     tt = np.array([tsegs[0]["t_start"]] + [s["t_end"] for s in tsegs])
     rows = []
     for s in tsegs:
-        ov = [max(0.0, min(s["t_end"], f["t_end"]) - max(s["t_start"], f["t_start"])) for f in fit]
-        f = fit[int(np.argmax(ov))]
+        f = _most_overlapping(s, fit)
         rows.append({"duration_s": s["t_end"] - s["t_start"], "Gq_true": s["Gq_n0"], "Gq_fit": f["Gq_n0"],
                      "w_true": s["w"], "w_fit": f["w"], "dlnGq": abs(math.log(f["Gq_n0"] / s["Gq_n0"])),
                      "dw": abs(f["w"] - s["w"]), "class_true": class_of(s["Gq_n0"]),

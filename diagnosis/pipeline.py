@@ -1540,7 +1540,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     """
     from diagnosis.compare import distribution_shape, transmissibility
     from diagnosis.report import write_report
-    from diagnosis.verdict import OWN_STATISTIC_NAMES, SIGNATURE_METHOD, search_ranges
+    from diagnosis.verdict import SIGNATURE_METHOD, own_statistic, search_ranges
     from diagnosis.which import combine_folds, rank_effects
     from diagnosis.where import localize
     from eroad.threads import process_pool
@@ -1611,7 +1611,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     for name, rng in ((side_rec or {}).get("ranges") or {}).items():
         if rng is not None and any(c.name == name for c in cands):
             progress(f"{name}: searched over {rng[0]:g}-{rng[1]:g} (the measured "
-                     f"{OWN_STATISTIC_NAMES.get(side_rec['statistic'], side_rec['statistic'])} "
+                     f"{own_statistic(side_rec['statistic']).name} "
                      f"{side_rec['measured']:+.3f} against the nominal model's "
                      f"{np.mean([v for v in side_rec['nominal'] if v is not None]):+.3f})")
     progress(f"ranking {len(cands)} candidate effect(s) on {len(calib)} calibration + "

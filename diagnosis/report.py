@@ -38,16 +38,11 @@ from matplotlib.figure import Figure
 
 from eroad.errors import EroadInputError
 
-from .verdict import OWN_STATISTIC_NAMES, decide
+from .verdict import decide, own_statistic
 
 __all__ = ["build_summary", "write_report", "plot_heatmap", "plot_segments",
            "plot_transmissibility", "plot_ranking", "plot_shrink_bands", "render_markdown",
            "jsonable"]
-
-
-def _own_name(statistic) -> str:
-    """How the report names an own-signature statistic (older summaries: the skewness)."""
-    return OWN_STATISTIC_NAMES.get(statistic or "stroke_velocity_skewness", str(statistic))
 
 
 def jsonable(obj: Any) -> Any:
@@ -500,7 +495,7 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                      + ".")
         O = D.get("signature_own")
         if O and O.get("agrees") is not None:
-            L.append(f" Its own signature, the {_own_name(O.get('statistic'))} (mean over the "
+            L.append(f" Its own signature, the {own_statistic(O.get('statistic')).name} (mean over the "
                      f"wheel stations; 0 for a linear truck on a Gaussian road; sd over road "
                      f"phases {O['sd']:.2g}): measured {O['measured']:+.3f}, nominal model "
                      f"{O['nominal_mean']:+.3f} (z {O['z_nominal']:+.1f}), with "
@@ -514,7 +509,7 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
         for name, rng in (side.get("ranges") or {}).items():
             if rng is not None and name in (summary.get("meta") or {}).get("candidates", []):
                 L.append(f" {name} was searched over {rng[0]:g}-{rng[1]:g} only: the measured "
-                         f"{_own_name(side.get('statistic'))} ({side['measured']:+.3f}) lies beyond the "
+                         f"{own_statistic(side.get('statistic')).name} ({side['measured']:+.3f}) lies beyond the "
                          f"nominal model's on the same road phases on that side.")
         L.append("")
     st = summary.get("localization_settings")

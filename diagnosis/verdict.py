@@ -271,16 +271,6 @@ TIE_RATIO = 0.7
 #: seed-73 blind check with the right model (z 3.1 and 4.8).  Saved summaries keep the
 #: statistic they were made with (``signature_own["statistic"]``) and are re-decided with it.
 OWN_SIGNATURE = {"damper_asymmetry": "stroke_velocity_l_skewness"}
-#: how reports name each statistic, and what it is
-OWN_STATISTIC_NAMES = {"stroke_velocity_skewness": "stroke-velocity skewness",
-                       "stroke_velocity_l_skewness": "stroke-velocity L-skewness"}
-OWN_STATISTIC_MEASURES = {
-    "stroke_velocity_skewness": (
-        "mean over the wheel stations of the skewness of the suspension stroke velocity "
-        "(suspension displacement band-passed 0.5-15 Hz, differentiated)"),
-    "stroke_velocity_l_skewness": (
-        "mean over the wheel stations of the L-skewness (Hosking 1990) of the suspension stroke "
-        "velocity (suspension displacement band-passed 0.5-15 Hz, differentiated)")}
 #: is the own signature used (else every effect takes the transmissibility test)
 SIGNATURE_OWN = True
 #: positive evidence asked of an own signature: the nominal model's value lies at least
@@ -295,16 +285,45 @@ SIGNATURE_OWN = True
 OWN_Z_NOMINAL = 2.5
 OWN_Z_MODEL = 3.0
 OWN_SHARE = 0.5
-#: smallest sd of each statistic over road phases [-]: with 2 x 5 records the pooled sd can
-#: come out small by chance.  Skewness: 0.03, below every value measured on the development
-#: drives (0.011-0.23 for the station mean over 3 road phases, mostly 0.05).  L-skewness:
-#: 0.003, chosen on our truck's 100 saved blind drives without a damper asymmetry (nominal
-#: model's sd over 5 phases 0.0023-0.0085, 5-95 %; 0.003 takes a side on 2 of them, 0.002
-#: on 3, no damper drive's departure falls below 4.4 sd with either); checked on the
-#: independent truck's 72 (7 sides at 0.003).
-OWN_SD_FLOORS = {"stroke_velocity_skewness": 0.03, "stroke_velocity_l_skewness": 0.003}
-#: the floor of the statistic in use
+@dataclass(frozen=True)
+class OwnStatistic:
+    """What the verdict and the report need of an own-signature statistic (the function that
+    computes it: :data:`diagnosis.compare.OWN_STATISTICS`, same keys)."""
+
+    name: str        # how reasons and reports name it
+    measure: str     # what it is, for summary.json
+    sd_floor: float  # smallest prediction sd over road phases [-]
+
+
+#: every own-signature statistic a summary may carry (``signature_own["statistic"]``,
+#: ``meta.own_side.statistic``).  ``sd_floor``: with 2 x 5 records the pooled sd can come out
+#: small by chance.  Skewness: 0.03, below every value measured on the development drives
+#: (0.011-0.23 for the station mean over 3 road phases, mostly 0.05).  L-skewness: 0.003,
+#: chosen on our truck's 100 saved blind drives without a damper asymmetry (nominal model's
+#: sd over 5 phases 0.0023-0.0085, 5-95 %; 0.003 takes a side on 2 of them, 0.002 on 3, no
+#: damper drive's departure falls below 4.4 sd with either); checked on the independent
+#: truck's 72 (7 sides at 0.003).
+OWN_STATISTICS_USED = {
+    "stroke_velocity_skewness": OwnStatistic(
+        "stroke-velocity skewness",
+        "mean over the wheel stations of the skewness of the suspension stroke velocity "
+        "(suspension displacement band-passed 0.5-15 Hz, differentiated)", 0.03),
+    "stroke_velocity_l_skewness": OwnStatistic(
+        "stroke-velocity L-skewness",
+        "mean over the wheel stations of the L-skewness (Hosking 1990) of the suspension stroke "
+        "velocity (suspension displacement band-passed 0.5-15 Hz, differentiated)", 0.003),
+}
+#: the floors by statistic, and the floor of the statistic in use
+OWN_SD_FLOORS = {k: v.sd_floor for k, v in OWN_STATISTICS_USED.items()}
 OWN_SD_FLOOR = OWN_SD_FLOORS[OWN_SIGNATURE["damper_asymmetry"]]
+
+
+def own_statistic(key: str | None) -> OwnStatistic:
+    """The :class:`OwnStatistic` of ``key``; a missing or unknown key means the statistic in
+    use (``OWN_SIGNATURE``)."""
+    return OWN_STATISTICS_USED.get(key) or OWN_STATISTICS_USED[OWN_SIGNATURE["damper_asymmetry"]]
+
+
 #: a winner calibrated at an edge of its search range is still named (``ambiguous``, never
 #: ``clear`` nor ``identified``, the value a bound) when its own road-independent signature
 #: agrees: the edge rule withholds a name because a value pinned at the range's end may
@@ -324,7 +343,7 @@ def own_signature(effect: str, measured: float, nominal, model) -> dict:
     one per phase).  The verdict (:func:`own_signature_agrees`) derives everything else, so
     a saved summary can be re-decided with other thresholds."""
     stat = OWN_SIGNATURE[effect]
-    return {"effect": effect, "statistic": stat, "measure": OWN_STATISTIC_MEASURES[stat],
+    return {"effect": effect, "statistic": stat, "measure": own_statistic(stat).measure,
             "measured": _f(measured), "nominal": [_f(v) for v in nominal],
             "model": [_f(v) for v in model]}
 
@@ -334,8 +353,8 @@ def own_signature_agrees(record: Mapping, z_nominal: float = OWN_Z_NOMINAL,
     """Does the own signature give positive evidence for the candidate?
 
     With ``m`` the measured value, ``a`` and ``b`` the nominal and candidate models' values
-    over the same road phases (n each) and ``s`` their pooled sd (at least the statistic's
-    ``OWN_SD_FLOORS`` entry),
+    over the same road phases (n each) and ``s`` their pooled sd (at least the record's
+    statistic's ``sd_floor``, :func:`own_statistic`),
     the prediction sd of one measurement against a model's mean is ``s sqrt(1 + 1/n)``:
     ``z0 = (m - mean a) / sd``, ``z1 = (m - mean b) / sd``.  Agrees when ``|z0| >= z_nominal``
     (the nominal model does not make what was measured), ``|z1| <= z_model`` (the candidate
@@ -348,7 +367,7 @@ def own_signature_agrees(record: Mapping, z_nominal: float = OWN_Z_NOMINAL,
         return {"agrees": None}
     pooled = math.sqrt((((a - a.mean()) ** 2).sum() + ((b - b.mean()) ** 2).sum())
                        / (a.size + b.size - 2))
-    floor = OWN_SD_FLOORS.get(record.get("statistic"), OWN_SD_FLOOR)
+    floor = own_statistic(record.get("statistic")).sd_floor
     sd = max(pooled, floor) * math.sqrt(1.0 + 2.0 / (a.size + b.size))
     d0, d1 = float(m) - float(a.mean()), float(m) - float(b.mean())
     z0, z1 = d0 / sd, d1 / sd
@@ -363,13 +382,13 @@ def own_side(measured, nominal, z_nominal: float = OWN_Z_NOMINAL, statistic: str
     +1 (-1) where it lies at least ``z_nominal`` prediction sd above (below) the mean of the
     nominal model's values on the signature's road phases, else 0.  The prediction sd is
     ``max(sd, floor) sqrt(1 + 1/n)`` with the nominal values' own sd (n - 1 degrees of
-    freedom) and the floor of ``statistic`` (``OWN_SD_FLOORS``; default the one in use) --
+    freedom) and the floor of ``statistic`` (:func:`own_statistic`; default the one in use) --
     the candidate's values do not exist yet when the search range is set
     (``diagnosis.pipeline.OWN_SIDE``)."""
     a = np.asarray([v for v in (nominal or []) if v is not None], float)
     if measured is None or a.size < 2 or not math.isfinite(float(measured)):
         return 0
-    floor = OWN_SD_FLOORS.get(statistic, OWN_SD_FLOOR)
+    floor = own_statistic(statistic).sd_floor
     sd = max(float(a.std(ddof=1)), floor) * math.sqrt(1.0 + 1.0 / a.size)
     z = (float(measured) - float(a.mean())) / sd
     return 1 if z >= z_nominal else (-1 if z <= -z_nominal else 0)
@@ -565,8 +584,8 @@ class _SignatureTest:
 
 #: how the reason names the two signatures
 def _what_own(own_res: Mapping) -> str:
-    name = OWN_STATISTIC_NAMES.get(own_res.get("statistic"), "own-signature statistic")
-    return f"{name} (its own signature; the transmissibility, which it barely moves, is not used)"
+    return (f"{own_statistic(own_res.get('statistic')).name} (its own signature; the "
+            "transmissibility, which it barely moves, is not used)")
 
 
 def _what(sig_method: str) -> str:
