@@ -54,6 +54,35 @@ def test_calibrate_refines_the_second_basin_of_a_two_basin_grid(monkeypatch):
     assert calibrate([c], obj, grid=4, refine=3).effects["e"]["a"] < 0.34
 
 
+def test_a_wide_log_range_gets_a_finer_grid(monkeypatch):
+    """A one-parameter search over 3 decades (the frame's stiffness factor 0.1-100) with the
+    budget's 4 grid points would step a decade at a time; ``grid_points`` gives it 6 (0.6
+    decade a step, GRID_MAX_DECADES 0.65), ranges of up to 1.95 decades keep 4 and a linear
+    range keeps 4.  The objective: a slope rising with log10 x and a well 0.3 decade wide at
+    x = 3 (the weak-frame drives' truths were 1.8-7.6), whose depth the 1-decade grid does not
+    see (grid values 0.30, 0.33, 0.39, 0.45: best at the 0.1 edge, which the golden section
+    within a decade of it cannot leave).  With 6 points the grid's best is 10^0.2 and 3 golden
+    evaluations between 10^-0.4 and 10^0.8 reach 10^0.52 (0.15 decade asked)."""
+    import diagnosis.which as which
+    from diagnosis.which import grid_points
+
+    assert grid_points(Param("k", 0.1, 100.0, log=True), 4) == 6
+    assert grid_points(Param("gap", 0.001, 0.08, log=True), 4) == 4
+    assert grid_points(Param("ratio", 0.2, 8.0, log=True), 4) == 4
+    assert grid_points(Param("mass", -14000.0, 14000.0), 4) == 4
+
+    def obj(e):
+        lg = np.log10(e["e"]["k"])
+        return 0.30 + 0.05 * (lg + 1.0) - 0.25 * np.exp(-((lg - np.log10(3.0)) / 0.3) ** 2)
+
+    c = Candidate("e", (Param("k", 0.1, 100.0, log=True),))
+    cal = calibrate([c], obj, grid=4, refine=3)
+    assert np.log10(cal.effects["e"]["k"]) == pytest.approx(np.log10(3.0), abs=0.15)
+    assert cal.n_evals <= 6 + 3 + 3
+    monkeypatch.setattr(which, "GRID_MAX_DECADES", 10.0)     # the old grid: 4 points
+    assert calibrate([c], obj, grid=4, refine=3).effects["e"]["k"] < 0.2
+
+
 def test_candidates_from_library_reads_an_effect_registry():
     """Duck-typed registry (objects with .parameters of name/default/range): up to two
     calibrated parameters, log search for wide positive ranges, the rest fixed at defaults."""
