@@ -131,6 +131,37 @@ def test_ranking_picks_sensor_dynamics():
     assert r.winner.effects["sensor"]["cutoff_hz"] == pytest.approx(15.0, rel=0.2)
 
 
+def test_calibrations_are_submitted_longest_first_and_come_back_in_candidate_order(monkeypatch):
+    """The worker pool gets the single-candidate calibrations in ``TASK_ORDER`` (longest first)
+    and the ranking's entries come back in the candidates' order with the same values as
+    without a pool.  An executor that records what it is handed stands in for the pool; the
+    toy's candidates are given a task order that reverses theirs."""
+    import diagnosis.which as which
+    from diagnosis.which import submission_order
+
+    assert submission_order(["speed_scale", "leaf_friction", "x", "bump_stop"]) == [1, 3, 0, 2]
+    names = [c.name for c in toy.TOY_CANDIDATES]
+    monkeypatch.setattr(which, "TASK_ORDER", tuple(reversed(names)))
+
+    class Recording:
+        handed = []
+
+        def map(self, fn, tasks):
+            tasks = list(tasks)
+            Recording.handed.append([t[1][0].name for t in tasks])
+            return map(fn, tasks)
+
+    calib, held = _windows({"sensor": {"cutoff_hz": 15.0}}, 12)
+    kw = dict(seed=6, n_seeds=2, n_null=4, grid=3, refine=2, pairs=False)
+    a = rank_effects(toy.TOY_CANDIDATES, toy.fit, toy.simulate, calib, held, **kw)
+    b = rank_effects(toy.TOY_CANDIDATES, toy.fit, toy.simulate, calib, held, executor=Recording(),
+                     **kw)
+    assert Recording.handed[0] == list(reversed(names))
+    assert [e.effect for e in b.entries] == [e.effect for e in a.entries]
+    assert [e.heldout_gap_after for e in b.entries] == [e.heldout_gap_after for e in a.entries]
+    assert b.verdict == a.verdict
+
+
 def test_ranking_says_none_on_null_data():
     """Truth = nominal model: no candidate may be accepted and the verdict is "none"."""
     calib, held = _windows({}, 13)
