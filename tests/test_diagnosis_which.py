@@ -141,7 +141,6 @@ def test_calibrations_are_submitted_longest_first_and_come_back_in_candidate_ord
 
     assert submission_order(["speed_scale", "leaf_friction", "x", "bump_stop"]) == [1, 3, 0, 2]
     names = [c.name for c in toy.TOY_CANDIDATES]
-    monkeypatch.setattr(which, "TASK_ORDER", tuple(reversed(names)))
 
     class Recording:
         handed = []
@@ -153,12 +152,15 @@ def test_calibrations_are_submitted_longest_first_and_come_back_in_candidate_ord
 
     calib, held = _windows({"sensor": {"cutoff_hz": 15.0}}, 12)
     kw = dict(seed=6, n_seeds=2, n_null=4, grid=3, refine=2, pairs=False)
+    monkeypatch.setattr(which, "TASK_ORDER", tuple(names))              # the candidates' order
     a = rank_effects(toy.TOY_CANDIDATES, toy.fit, toy.simulate, calib, held, **kw)
+    monkeypatch.setattr(which, "TASK_ORDER", tuple(reversed(names)))    # reversed
     b = rank_effects(toy.TOY_CANDIDATES, toy.fit, toy.simulate, calib, held, executor=Recording(),
                      **kw)
     assert Recording.handed[0] == list(reversed(names))
     assert [e.effect for e in b.entries] == [e.effect for e in a.entries]
     assert [e.heldout_gap_after for e in b.entries] == [e.heldout_gap_after for e in a.entries]
+    assert [e.effects for e in b.entries] == [e.effects for e in a.entries]
     assert b.verdict == a.verdict
 
 
