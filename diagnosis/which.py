@@ -248,7 +248,7 @@ BASINS = 2
 #: widest grid step of a one-parameter search in log space [decades]: the grid gets as many
 #: points as keep its step at or below this (:func:`grid_points`).  With the budget's 4 points
 #: the frame's stiffness factor (0.1-100, 3 decades) was searched one decade a step and its
-#: calibration split between folds on the weak-frame blind drives (truth 2.2-3.8: folds at
+#: calibration split between folds on the weak-frame blind drives (truth 1.8-3.5: folds at
 #: 0.1 / 2.97, 10 / 3.37, 0.24 / 1.72, 1.72 / 0.1; results/diagnosis_blind/20261127-*), while
 #: every other log range of the library (1.3-1.9 decades) is searched at 0.43-0.63 decades a
 #: step.  0.65 gives the frame 6 points (0.6 decade) and leaves the others' grids unchanged.
@@ -932,22 +932,11 @@ class _Scorer:
 
 
 
-#: the order single-candidate calibrations are handed to the worker pool: longest first, so that
-#: two workers finish together (longest-processing-time-first scheduling).  Measured per task on
-#: blind drive 2 of results/diagnosis_blind/20261127-frame-grid-fresh-40/nominal (one fold, s):
-#: leaf_friction 24.6, damper_asymmetry 15.1, bump_stop 11.2, frame_flex 5.8, tyre_enveloping
-#: 3.8, payload 3.1, sensor 3.1, speed_scale 2.0 (stiff friction and bump stop take the
-#: solver's small steps).  In the library's order the pair (damper, friction) fell on one
-#: worker: 39.7 s against 29 s on the other.  Names not listed go last, in their given order.
-#: Only the order of work changes: every task is seeded on its own, the results are the same.
-TASK_ORDER = ("leaf_friction", "damper_asymmetry", "bump_stop", "frame_flex", "tyre_enveloping",
-              "payload", "sensor", "speed_scale")
-
-
-def submission_order(names: Sequence[str]) -> list[int]:
-    """Indices of ``names`` in the order their calibrations are submitted (``TASK_ORDER``
-    first, in its order; the rest after, in the order given)."""
-    rank = {n: i for i, n in enumerate(TASK_ORDER)}
+def submission_order(names: Sequence[str], order: Sequence[str] = ()) -> list[int]:
+    """Indices of ``names`` in the order their calibrations are handed to the worker pool:
+    the names in ``order`` first, in its order (longest first: the caller's measured costs,
+    e.g. ``diagnosis.pipeline.TASK_ORDER``), the rest after, in the order given."""
+    rank = {n: i for i, n in enumerate(order)}
     return sorted(range(len(names)), key=lambda i: (rank.get(names[i], len(rank)), i))
 
 
@@ -986,7 +975,8 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                  bands: np.ndarray | None = None, z: float = 2.0, grid: int = 5, refine: int = 8,
                  executor=None, progress: Callable[[str], None] | None = None,
                  delay: DelayTerm | None = None, shape: "ShapeTerm | None" = None,
-                 z_paired: float = 3.0, extra_terms: Sequence = ()) -> Ranking:
+                 z_paired: float = 3.0, extra_terms: Sequence = (),
+                 task_order: Sequence[str] = ()) -> Ranking:
     """Rank candidate effects by held-out gap, penalised for parameters; never force a verdict.
 
     Parameters
@@ -1021,6 +1011,9 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
         Search budget (see :func:`calibrate`).
     executor : concurrent.futures.Executor, optional
         Candidates are calibrated in parallel with ``executor.map``.
+    task_order : sequence of str
+        Candidate names, longest calibration first: the order the calibrations are handed to
+        ``executor`` (:func:`submission_order`); only the order of work changes.
     progress : callable str -> None, optional
     delay : DelayTerm, optional
         Front-to-rear delay mismatch added to every gap (see :class:`DelayTerm`); its
@@ -1099,8 +1092,8 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
         return replace(e, beyond_noise=bool(bn), accepted=bool(ok))
 
     say(f"calibrating {len(candidates)} candidates")
-    # submitted longest first (TASK_ORDER), results taken back in the candidates' order
-    order = submission_order([c.name for c in candidates])
+    # submitted longest first (task_order), results taken back in the candidates' order
+    order = submission_order([c.name for c in candidates], task_order)
     mapper = executor.map if executor is not None else map
     done = dict(zip(order, mapper(_score_task, [(sc, [candidates[i]], grid, refine, None)
                                                 for i in order])))

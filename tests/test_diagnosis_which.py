@@ -131,15 +131,15 @@ def test_ranking_picks_sensor_dynamics():
     assert r.winner.effects["sensor"]["cutoff_hz"] == pytest.approx(15.0, rel=0.2)
 
 
-def test_calibrations_are_submitted_longest_first_and_come_back_in_candidate_order(monkeypatch):
-    """The worker pool gets the single-candidate calibrations in ``TASK_ORDER`` (longest first)
+def test_calibrations_are_submitted_longest_first_and_come_back_in_candidate_order():
+    """The worker pool gets the single-candidate calibrations in ``task_order`` (longest first)
     and the ranking's entries come back in the candidates' order with the same values as
     without a pool.  An executor that records what it is handed stands in for the pool; the
     toy's candidates are given a task order that reverses theirs."""
-    import diagnosis.which as which
     from diagnosis.which import submission_order
 
-    assert submission_order(["speed_scale", "leaf_friction", "x", "bump_stop"]) == [1, 3, 0, 2]
+    order = ("leaf_friction", "bump_stop", "speed_scale")
+    assert submission_order(["speed_scale", "leaf_friction", "x", "bump_stop"], order) == [1, 3, 0, 2]
     names = [c.name for c in toy.TOY_CANDIDATES]
 
     class Recording:
@@ -152,11 +152,10 @@ def test_calibrations_are_submitted_longest_first_and_come_back_in_candidate_ord
 
     calib, held = _windows({"sensor": {"cutoff_hz": 15.0}}, 12)
     kw = dict(seed=6, n_seeds=2, n_null=4, grid=3, refine=2, pairs=False)
-    monkeypatch.setattr(which, "TASK_ORDER", tuple(names))              # the candidates' order
-    a = rank_effects(toy.TOY_CANDIDATES, toy.fit, toy.simulate, calib, held, **kw)
-    monkeypatch.setattr(which, "TASK_ORDER", tuple(reversed(names)))    # reversed
+    a = rank_effects(toy.TOY_CANDIDATES, toy.fit, toy.simulate, calib, held,
+                     task_order=tuple(names), **kw)                      # the candidates' order
     b = rank_effects(toy.TOY_CANDIDATES, toy.fit, toy.simulate, calib, held, executor=Recording(),
-                     **kw)
+                     task_order=tuple(reversed(names)), **kw)            # reversed
     assert Recording.handed[0] == list(reversed(names))
     assert [e.effect for e in b.entries] == [e.effect for e in a.entries]
     assert [e.heldout_gap_after for e in b.entries] == [e.heldout_gap_after for e in a.entries]
