@@ -463,3 +463,33 @@ def test_truck_sign_of_the_skewness_follows_the_ratio(tmp_path):
         synth_command(scenario="null", seed=5, effects=[f"damper_asymmetry.ratio={r!r}"], out=out)
         sk[r] = stroke_velocity_l_skewness(load_measured(out)[1])
     assert sk[3.0] > 0.015 and sk[1 / 3.0] < -0.01
+
+
+def test_an_overshoot_within_noise_agrees_and_a_short_move_does_not():
+    # identical records: the prediction sd is the L-skewness floor, 0.003 sqrt(1.2) = 0.00329.
+    # The nominal model makes 0, the measurement is +0.015 (4.6 sd off).  A candidate at
+    # +0.0235 moves the statistic 1.57 of the way (overshoot, 2.6 sd beyond the measurement,
+    # within OWN_Z_MODEL): it agrees.  The rule before 2026-11-27 (night) capped the
+    # overshoot at half the difference and refused it (blind case 5 of the frame-grid set).
+    sd = OWN_SD_FLOOR * math.sqrt(1.2)
+    over = own_signature_agrees(own_signature("damper_asymmetry", 0.015, [0.0] * 5, [0.0235] * 5))
+    assert over["moved"] == pytest.approx(0.0235 / 0.015, rel=1e-9)
+    assert over["z_model"] == pytest.approx(-0.0085 / sd, rel=1e-9)
+    assert abs(over["z_model"]) <= OWN_Z_MODEL and over["agrees"] is True
+    d = decide(_summary(own=own_signature("damper_asymmetry", 0.015, [0.0] * 5, [0.0235] * 5)))
+    assert d["verdict"] == "damper_asymmetry"
+    # a candidate at +0.006 moves it 0.4 of the way: within OWN_Z_MODEL of the measurement
+    # (2.7 sd) but short of OWN_SHARE: refused, and the drive is unexplained
+    short = own_signature_agrees(own_signature("damper_asymmetry", 0.015, [0.0] * 5, [0.006] * 5))
+    assert abs(short["z_model"]) <= OWN_Z_MODEL and short["moved"] == pytest.approx(0.4)
+    assert short["agrees"] is False
+    d = decide(_summary(own=own_signature("damper_asymmetry", 0.015, [0.0] * 5, [0.006] * 5)))
+    assert d["verdict"] == "unexplained"
+    # too far beyond the measurement: +0.03 is 4.6 sd past it
+    far = own_signature_agrees(own_signature("damper_asymmetry", 0.015, [0.0] * 5, [0.03] * 5))
+    assert far["agrees"] is False
+
+
+def test_a_short_move_is_said_in_the_reason():
+    d = decide(_summary(own=own_signature("damper_asymmetry", 0.015, [0.0] * 5, [0.006] * 5)))
+    assert "moves the statistic 40% of the way" in d["reason"] and "at least 50% asked" in d["reason"]
