@@ -664,6 +664,7 @@ def load_measured(dataset):
     sig = Signals(t - t[0], {c: np.asarray(drive.channels[c], float) for c in names},
                   {c: drive.units.get(c, "") for c in names}, np.asarray(drive.speed, float),
                   {"dataset": drive.name, "t0": 0.0,
+                   "susp_disp_zero": str(drive.meta.get("susp_disp_zero", "unknown")),
                    **({"resampled_from_hz": resampled["from_hz"]} if resampled else {})})
     return drive, sig
 
@@ -1271,6 +1272,28 @@ def stroke_velocity_term(model: TruckModel):
     return StrokeVelocityTerm(ch) if ch and STROKE_VELOCITY_TERM else None
 
 
+#: the static suspension offset as a term of the gap where the dataset declares the
+#: displacement zero at the nominal vehicle at rest (:func:`static_term`); on since 2026-11-27
+#: (night), docs/diagnosis.md "The static offset"
+STATIC_TERM = True
+#: the dataset declaration that makes the mean suspension displacement evidence
+#: (``meta.toml [dataset] susp_disp_zero``; ``drives.format.SUSP_DISP_ZERO``)
+STATIC_ZERO = "nominal_static"
+
+
+def static_term(model: TruckModel, sig: Signals):
+    """The static-offset term of the gap (:class:`diagnosis.which.StaticOffsetTerm`): the mean
+    of every suspension displacement channel, only where the measurement declares its zero to
+    be the nominal vehicle at rest (``sig.meta["susp_disp_zero"]``); else None (a sensor zeroed
+    on the laden truck, or an unknown zero, says nothing about the static load)."""
+    from diagnosis.which import StaticOffsetTerm
+
+    if not STATIC_TERM or (sig.meta or {}).get("susp_disp_zero") != STATIC_ZERO:
+        return None
+    ch = [c for c in model.channels if c.startswith("susp_disp_")]
+    return StaticOffsetTerm(ch) if ch else None
+
+
 def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: int = 4,
                    n_windows: int = 4, n_null: int = 12, delay: bool = True) -> dict:
     """Held-out gap of the nominal model and of the model with ``effects`` (given, not
@@ -1293,7 +1316,7 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
     sc = _Scorer(Fit(ctx.model), Simulate(ctx.model), ctx.calib, ctx.held, seed, 1, n_seeds,
                  None, None)
     terms = [delay_term(ctx.model), shape_term(ctx.model), transmissibility_term(ctx.model),
-             stroke_velocity_term(ctx.model)] if delay else []
+             stroke_velocity_term(ctx.model), static_term(ctx.model, sig)] if delay else []
     surrogates = _set_terms(sc, terms, n_null)
     sc.set_null(surrogates)
     g0, m0 = sc.heldout_scores({})
@@ -1632,7 +1655,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         rankings = [rank_effects(cands, fit, simulate, c, h, seed=sd, executor=ex,
                                  progress=progress, delay=delay_term(model),
                                  shape=shape_term(model),
-                                 extra_terms=[transmissibility_term(model), stroke_velocity_term(model)],
+                                 extra_terms=[transmissibility_term(model), stroke_velocity_term(model),
+                                              static_term(model, sig)],
                                  task_order=TASK_ORDER, **kw)
                     for c, h, sd in splits]
         ranking = rankings[0] if folds == 1 else combine_folds(rankings, candidates=cands)

@@ -659,7 +659,9 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
 def _terms_text(settings: Mapping) -> str:
     """The road-independent terms of the gap, with the nominal model's z on held-out data."""
     what = {"delay": "the front-to-rear delay mismatch",
-            "shape": "the suspension-displacement skewness mismatch"}
+            "shape": "the suspension-displacement skewness mismatch",
+            "static offset": "the mean suspension displacement mismatch (the dataset declares "
+                             "its zero at the nominal vehicle at rest: a static load shows)"}
     parts = []
     for key, text in what.items():
         t = settings.get(key)

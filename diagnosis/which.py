@@ -773,6 +773,35 @@ class StrokeVelocityTerm(_ChannelTerm):
 
 
 @dataclass
+class StaticOffsetTerm(_ChannelTerm):
+    """Static suspension offset as a term of the gap: the mean of every ``channels``
+    (suspension displacement) per window, where the dataset declares its displacement zero to
+    be the NOMINAL vehicle at rest (``[dataset] susp_disp_zero = "nominal_static"``, what
+    ``eroad synth`` writes for both truth families).  A heavier body sits lower whatever the
+    road, so a payload error shows as a mean compression of millimetres to centimetres that
+    band powers from 0.5 Hz up never see (blind payload drives of 7-12 t: 14-33 mm, drives
+    without an effect: within 0.2 mm); an asymmetric damper jacks the body down and a bump
+    stop pushes it up by a few millimetres.  ``rho_j`` is the mean over the channels of
+    ``mean_sim - mean_meas`` [m]; the rest as :class:`WindowTerm`.
+    """
+
+    #: a declared zero is not known better than about half a millimetre (transducer zeroing
+    #: and rest-position repeatability); the road-phase scatter of a 7.5 s window's mean is
+    #: smaller (0.05-0.2 mm on the blind drives), so the floor sets the scale
+    SIGMA_FLOOR = 5.0e-4
+    label = "static offset"
+
+    def _per_channel(self, signals) -> dict:
+        out = {}
+        for c in self.channels:
+            if c in signals.channels:
+                x = np.asarray(signals.channels[c], float)
+                if x.size and np.all(np.isfinite(x)):
+                    out[c] = float(x.mean())
+        return out
+
+
+@dataclass
 class TransmissibilityTerm(WindowTerm):
     """Axle-to-body transmissibility mismatch as a term of the gap (road-independent in the
     main: a heavier body, a locked leaf spring or a stiffer mount changes how the body answers
@@ -1134,7 +1163,8 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
                     grid=grid, refine=refine, pairs=pairs, channels=sc.ref_held.channels,
                     n_calib_windows=len(sc.calib), n_heldout_windows=len(sc.heldout),
                     delay=term_info.get("delay"), shape=term_info.get("shape"),
-                    **({"transmissibility": term_info["transmissibility"]} if "transmissibility" in term_info else {}))
+                    **{k: term_info[k] for k in ("transmissibility", "static offset")
+                       if k in term_info})
     return Ranking(entries, before, pb_before, floor, _nanmean([g.per_band_floor for g in g0]), null,
                    gap_present, verdict, conf, reason, sc.ref_held.bands, settings)
 

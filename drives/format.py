@@ -54,6 +54,13 @@ CHUNK_ROWS = 200_000
 TIME_JITTER_REL = 1e-6
 #: allowed relative disagreement of meta sample_rate_hz with the time column [-]
 RATE_REL_TOL = 1e-6
+#: optional ``[dataset] susp_disp_zero``: where the suspension displacements read 0.
+#: ``"nominal_static"``: the NOMINAL vehicle (the vehicle file's parameters, its rated
+#: payload) at rest on level ground, so the mean displacement carries a static load difference
+#: (``eroad synth`` writes it for both truth families; ``eroad diagnose`` then uses the mean as
+#: evidence, docs/diagnosis.md "The static offset").  ``"unknown"`` (the default): sensors
+#: zeroed on the vehicle as driven, or nobody knows; the mean is not used.
+SUSP_DISP_ZERO = ("nominal_static", "unknown")
 
 #: built-in vehicle ids, used when the ``vehicles`` package ships no parameter files
 BUILTIN_VEHICLES_FALLBACK = ("dump_truck_8x4", "e_tractor")
@@ -752,6 +759,10 @@ def inspect_drive(folder) -> tuple[list[str], Drive | None]:
         if "speed_mps" not in ds and cols is not None and not has_speed_col:
             probs.items[-1] += " (channels.csv has no speed column, so meta must give it)"
         _number(metaf, ds, "start_time_s", probs, required=False)
+        zero = ds.get("susp_disp_zero", "unknown")
+        if zero not in SUSP_DISP_ZERO:
+            probs.add(metaf, f"[dataset] susp_disp_zero = {zero!r} is not one of "
+                      + ", ".join(f'"{z}"' for z in SUSP_DISP_ZERO))
         vehicle = _resolve_vehicle(folder, ds, probs)
         units = _check_units(folder, doc, cols, probs)
         if rate is not None and step is not None:

@@ -922,7 +922,10 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
                                       "window"))
             write_drive(tmp / RECORD_DIR, record_noisy, rmeta, vehicle_file=vfile)
 
+    # both truth models zero their outputs at the nominal vehicle's static equilibrium
+    # (a payload error sags the mean displacement): say so (drives.format.SUSP_DISP_ZERO)
     meta = {"name": sc["dataset_name"], "sample_rate_hz": fs, "start_time_s": ds_start,
+            "susp_disp_zero": "nominal_static",
             "description": "virtual test drive (eroad synth); what made it is in truth/"}
     if window is not None:
         meta["description"] = (f"virtual test drive (eroad synth), the {window[0]:g}-{window[1]:g} s "

@@ -328,6 +328,59 @@ def test_shape_term_skewness_and_its_noise():
     assert abs(term.z([window(True) for _ in range(4)], "held")) > 5
 
 
+def test_static_offset_term_means_and_floor():
+    """:class:`diagnosis.which.StaticOffsetTerm`: the per-window mean of each displacement
+    channel (exact on a hand window), ``rho`` the channel-mean of sim - meas, and ``z`` on the
+    floor's scale: simulations whose window means scatter by 0.01 mm (far below the 0.5 mm
+    floor) against a measurement 10 mm lower (a payload's sag) give z = 10 mm / (0.5 mm
+    sqrt 2) per window, sqrt(4) of that over four windows, 28.3; the same offset as measured
+    gives 0 (to the scatter's 0.03); a channel the model lacks does not count."""
+    from diagnosis.signals import Signals
+    from diagnosis.which import StaticOffsetTerm
+
+    t = StaticOffsetTerm(["susp_disp_1L", "susp_disp_1R"], weight=1.0)
+    hand = Signals(np.arange(4) / 4.0, {"susp_disp_1L": np.array([0.0, 1.0, 2.0, 5.0]),
+                                        "susp_disp_1R": np.array([1.0, 1.0, 1.0, 1.0])})
+    assert np.allclose(t.stats([hand])[0], [2.0, 1.0], rtol=0, atol=1e-15)
+    assert t.SIGMA_FLOOR == pytest.approx(5e-4)
+
+    rng = np.random.default_rng(3)
+
+    def window(offset):
+        n = 400
+        return Signals(np.arange(n) / 200.0,
+                       {c: offset + 1e-5 * rng.standard_normal() + 0.01 * np.sin(np.arange(n) / 7.0)
+                        for c in ("susp_disp_1L", "susp_disp_1R", "body_acc_1L")})
+
+    meas = [window(-0.010) for _ in range(4)]
+    t.prepare("held", meas, [[window(0.0) for _ in range(4)] for _ in range(6)])
+    assert np.all(t._sigma["held"] == pytest.approx(5e-4))          # the floor, not the scatter
+    z_nom = t.z([window(0.0) for _ in range(4)], "held")
+    # the nominal simulations sit 10 mm above the measured (sagging) drive
+    assert z_nom == pytest.approx(0.010 / (5e-4 * np.sqrt(2.0)) * 2.0, rel=0.02)
+    assert abs(t.z([window(-0.010) for _ in range(4)], "held")) < 0.1
+    assert t.term([window(0.0) for _ in range(4)], "held") == pytest.approx(z_nom ** 2, rel=0.01)
+
+
+def test_static_term_only_where_the_zero_is_declared():
+    """The static offset is evidence only where the measurement says its displacements read 0
+    on the nominal vehicle at rest; a sensor zeroed on the laden truck (or an unknown zero)
+    says nothing about the static load."""
+    from types import SimpleNamespace
+
+    from diagnosis.pipeline import static_term
+    from diagnosis.signals import Signals
+    from diagnosis.which import StaticOffsetTerm
+
+    model = SimpleNamespace(channels=["susp_disp_3L", "susp_disp_3R", "axle_acc_3L"])
+    sig = lambda zero: Signals(np.arange(4) / 4.0, {"susp_disp_3L": np.zeros(4)},
+                               meta={} if zero is None else {"susp_disp_zero": zero})
+    term = static_term(model, sig("nominal_static"))
+    assert isinstance(term, StaticOffsetTerm) and term.channels == ["susp_disp_3L", "susp_disp_3R"]
+    assert static_term(model, sig("unknown")) is None
+    assert static_term(model, sig(None)) is None
+
+
 #: the toy library plus a speed-signal scale (identified through the delay term): five
 #: candidates, so the verdict is a choice among many, not between two
 FIVE = list(toy.TOY_CANDIDATES) + [Candidate("speed_scale", (Param("scale", 0.85, 1.15),))]

@@ -125,3 +125,19 @@ def test_same_frame_same_bytes(tmp_path):
     b = write_drive(tmp_path / "b", frame(), {"name": "x", "vehicle": "dump_truck_8x4"})
     for f in ("channels.csv", "meta.toml"):
         assert (a / f).read_bytes() == (b / f).read_bytes()
+
+
+def test_the_displacement_zero_declaration(tmp_path):
+    """``[dataset] susp_disp_zero``: optional, "nominal_static" or "unknown"; anything else is
+    refused with one line naming meta.toml and the key."""
+    d = read_drive(write_drive(tmp_path / "a", frame(), {"vehicle": "dump_truck_8x4",
+                                                         "susp_disp_zero": "nominal_static"}))
+    assert d.meta["susp_disp_zero"] == "nominal_static"
+    assert "susp_disp_zero" not in read_drive(write_drive(tmp_path / "b", frame(),
+                                                          {"vehicle": "dump_truck_8x4"})).meta
+    write_drive(tmp_path / "c", frame(), {"vehicle": "dump_truck_8x4"})
+    meta = tmp_path / "c" / "meta.toml"
+    meta.write_text(meta.read_text() + 'susp_disp_zero = "laden"\n')
+    probs = check_drive(tmp_path / "c")
+    assert len(probs) == 1 and "meta.toml" in probs[0] and "susp_disp_zero = 'laden'" in probs[0]
+    assert '"nominal_static", "unknown"' in probs[0]
