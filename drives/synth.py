@@ -1011,8 +1011,10 @@ def read_truth(dataset) -> dict:
 
 #: the truth model's version, part of the default dataset's cache key: change it whenever
 #: the simulation of a scenario changes its output (a cached record made by an older model
-#: must not be served as the embedded dataset).  2026-11-25: one-sided tyres.
-TRUTH_MODEL_VERSION = "2026-11-25 one-sided tyres; truth_model in the truth summary"
+#: must not be served as the embedded dataset).  2026-11-25: one-sided tyres.  2026-11-27:
+#: meta.toml declares the displacement zero (``susp_disp_zero``), which the diagnosis reads.
+TRUTH_MODEL_VERSION = ("2026-11-27 one-sided tyres; truth_model in the truth summary; "
+                       "susp_disp_zero declared")
 
 
 def _scenario_key() -> str:
