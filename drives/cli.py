@@ -129,6 +129,13 @@ def format_summary(s: dict) -> str:
                                  f"spacing ({sc['agree']} of {sc['pairs']} axle pairs agree; 1 for a right speed)"
                                  if sc else "not measured (needs two axles of one side and the vehicle's "
                                  "axle positions)"))
+    if any(c.startswith("susp_disp_") for c in s["channels"]):
+        lines.append("disp zero " + ("the nominal vehicle at rest (declared): the mean displacement "
+                                     "is evidence of a static load (eroad diagnose uses it)"
+                                     if s.get("susp_disp_zero") == "nominal_static" else
+                                     "unknown: the mean displacement is not used (declare "
+                                     "susp_disp_zero = \"nominal_static\" in meta.toml if the "
+                                     "sensors were zeroed on the nominal vehicle at rest)"))
     lines += [f"warning   {w}" for w in s.get("warnings", [])]
     return "\n".join(lines)
 

@@ -319,7 +319,7 @@ class Drive:
         dict
             name, n_samples, duration_s, sample_rate_hz, t_start_s, t_end_s,
             channels, speed_min_mps, speed_max_mps, speed_source, vehicle, vehicle_is_file,
-            warnings, speed_check.
+            warnings, speed_check, susp_disp_zero.
         """
         veh = self.vehicle.name if isinstance(self.vehicle, Path) else self.vehicle
         return {
@@ -337,6 +337,7 @@ class Drive:
             "vehicle_is_file": isinstance(self.vehicle, Path),
             "warnings": list(self.warnings),
             "speed_check": self.speed_check,
+            "susp_disp_zero": str(self.meta.get("susp_disp_zero", "unknown")),
         }
 
 

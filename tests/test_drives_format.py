@@ -141,3 +141,22 @@ def test_the_displacement_zero_declaration(tmp_path):
     probs = check_drive(tmp_path / "c")
     assert len(probs) == 1 and "meta.toml" in probs[0] and "susp_disp_zero = 'laden'" in probs[0]
     assert '"nominal_static", "unknown"' in probs[0]
+
+
+def test_data_check_says_what_the_displacement_zero_is(tmp_path, capsys):
+    """`eroad data check` prints the declaration in one line (and in --json), so a user sees
+    whether the mean displacement will count as evidence."""
+    from eroad.cli import main
+
+    a = write_drive(tmp_path / "a", frame(), {"vehicle": "dump_truck_8x4",
+                                              "susp_disp_zero": "nominal_static"})
+    b = write_drive(tmp_path / "b", frame(), {"vehicle": "dump_truck_8x4"})
+    assert main(["data", "check", str(a)]) == 0
+    out = capsys.readouterr().out
+    assert "disp zero the nominal vehicle at rest (declared)" in out
+    assert main(["data", "check", str(b)]) == 0
+    assert "disp zero unknown: the mean displacement is not used" in capsys.readouterr().out
+    assert main(["data", "check", str(b), "--json"]) == 0
+    import json
+
+    assert json.loads(capsys.readouterr().out)["susp_disp_zero"] == "unknown"
