@@ -452,6 +452,9 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                  f"shrink fraction {H['shrink_fraction']:.2f} +- {_fmt(H['shrink_spread'], '{:.2f}')} "
                  f"across road-phase seeds (shrink of the part above sampling noise: "
                  f"{_fmt(H['shrink_excess'], '{:.2f}')}).\n")
+    static = _static_offset_text(summary)
+    if static:
+        L.append(static + "\n")
     D = summary.get("verdict_detail")
     if D and D.get("residual"):
         R = D["residual"]
@@ -654,6 +657,38 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
              "ISO 18571) are not used: the simulated road is a random-phase realisation, not the "
              "measured one. See docs/diagnosis.md.\n")
     return "\n".join(L)
+
+
+def _static_offset_text(summary: Mapping) -> str:
+    """One paragraph on the static-offset term where it was used: how far the nominal model's
+    mean suspension displacement sits from the measured one and what that term contributes to
+    the nominal held-out gap (``w z^2``, averaged over the folds as the gap is); "" without
+    the term."""
+    settings = (summary.get("nominal") or {}).get("settings") or {}
+    folds = [f.get("static offset") or {} for f in settings.get("fold_settings") or [settings]]
+    folds = [f for f in folds if f.get("z_nominal") and f.get("weight") and f.get("sigma_heldout")]
+    if not folds:
+        return ""
+    z = [float(np.mean(f["z_nominal"])) for f in folds]
+    part = float(np.mean([f["weight"] * float(np.mean(np.square(f["z_nominal"]))) for f in folds]))
+    # z = mean(rho) sqrt(n / (2 sigma^2)) for equal sigma over the n windows: the offset in m
+    offs = []
+    for f, zf in zip(folds, z):
+        sig = [x for x in f["sigma_heldout"] if x is not None and np.isfinite(x) and x > 0]
+        if sig:
+            offs.append(zf * math.sqrt(2.0 / len(sig)) * float(np.sqrt(np.mean(np.square(sig)))))
+    if not offs:
+        return ""
+    off, zm = float(np.mean(offs)), float(np.mean(z))
+    head = ("Static offset (the dataset declares its displacement zero at the nominal vehicle at "
+            "rest): averaged over the suspension displacements, ")
+    if abs(zm) < 2.0:
+        return (head + f"the nominal model's mean is within noise of the measured one "
+                f"({off * 1000:+.1f} mm, z {zm:+.1f}; floor 0.5 mm): no static load difference shows.")
+    return (head + f"the nominal model's mean sits {abs(off) * 1000:.1f} mm "
+            f"{'above' if off < 0 else 'below'} the measured one "
+            f"({'the measured truck sits lower' if off < 0 else 'the measured truck sits higher'}; "
+            f"z {zm:+.1f}, floor 0.5 mm); that term is {part:.3g} of the nominal held-out gap.")
 
 
 def _terms_text(settings: Mapping) -> str:

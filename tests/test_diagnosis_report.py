@@ -181,3 +181,20 @@ def test_verdict_line_gives_the_calibrated_value_with_its_unit_and_folds():
     line = render_markdown(json.loads(saved.read_text()), {}).splitlines()
     line = next(ln for ln in line if ln.startswith("**damper_asymmetry**"))
     assert "calibrated damper_asymmetry.ratio = 3.42" in line and "(folds 3.742, 3.127)" in line
+
+
+def test_the_report_says_how_far_the_static_offset_is():
+    """The static-offset paragraph: the offset in mm from z, the floor and the windows (two
+    windows at the 0.5 mm floor: offset = z * 0.5 mm), its sign in words, and the term's part of
+    the nominal gap averaged over the folds as the gap is; nothing without the term."""
+    from diagnosis.report import _static_offset_text
+
+    fold = lambda z, w: {"static offset": {"z_nominal": [z, z], "weight": w,
+                                           "sigma_heldout": [5e-4, 5e-4]}}
+    s = {"nominal": {"settings": {"fold_settings": [fold(-40.0, 0.02), fold(-38.0, 0.01)]}}}
+    txt = _static_offset_text(s)
+    assert "19.5 mm above the measured one (the measured truck sits lower; z -39.0" in txt
+    assert f"{(0.02 * 1600 + 0.01 * 1444) / 2:.3g} of the nominal held-out gap" in txt
+    quiet = {"nominal": {"settings": fold(0.4, 0.02)}}
+    assert "within noise" in _static_offset_text(quiet) and "+0.2 mm" in _static_offset_text(quiet)
+    assert _static_offset_text({"nominal": {"settings": {}}}) == ""
