@@ -679,16 +679,19 @@ def _static_offset_text(summary: Mapping) -> str:
             offs.append(zf * math.sqrt(2.0 / len(sig)) * float(np.sqrt(np.mean(np.square(sig)))))
     if not offs:
         return ""
+    from .which import StaticOffsetTerm
+
+    floor = f"floor {StaticOffsetTerm.SIGMA_FLOOR * 1000:g} mm"
     off, zm = float(np.mean(offs)), float(np.mean(z))
     head = ("Static offset (the dataset declares its displacement zero at the nominal vehicle at "
             "rest): averaged over the suspension displacements, ")
     if abs(zm) < 2.0:
         return (head + f"the nominal model's mean is within noise of the measured one "
-                f"({off * 1000:+.1f} mm, z {zm:+.1f}; floor 0.5 mm): no static load difference shows.")
+                f"({off * 1000:+.1f} mm, z {zm:+.1f}; {floor}): no static load difference shows.")
     return (head + f"the nominal model's mean sits {abs(off) * 1000:.1f} mm "
             f"{'above' if off < 0 else 'below'} the measured one "
             f"({'the measured truck sits lower' if off < 0 else 'the measured truck sits higher'}; "
-            f"z {zm:+.1f}, floor 0.5 mm); that term is {part:.3g} of the nominal held-out gap.")
+            f"z {zm:+.1f}, {floor}); that term is {part:.3g} of the nominal held-out gap.")
 
 
 def _terms_text(settings: Mapping) -> str:

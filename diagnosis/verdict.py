@@ -287,9 +287,9 @@ SIGNATURE_OWN = True
 #: difference; beyond the measurement (overshoot) only OWN_Z_MODEL bounds it.  It was
 #: ``|m - mean b| <= (1 - OWN_SHARE) |m - mean a|``, which also capped the overshoot at half
 #: the difference, a second bound on the same side as OWN_Z_MODEL and one without a noise
-#: scale: blind case 5 of 20261127-frame-grid-fresh-40 (ratio 2.99, calibrated 3.33, 44 % of
-#: the gap explained... its model moved the statistic 1.52 of the way, z -1.35) was refused
-#: by it alone.  Re-deciding every saved summary with truth changes that drive only.
+#: scale: blind case 5 of 20261127-frame-grid-fresh-40 (ratio 2.99, calibrated 3.33) was
+#: refused by that cap alone, its model having moved the statistic 1.52 of the way at z -1.35.
+#: Re-deciding every saved summary with truth changes that drive only.
 OWN_Z_NOMINAL = 2.5
 OWN_Z_MODEL = 3.0
 OWN_SHARE = 0.5
