@@ -327,6 +327,14 @@ def plot_transmissibility(summary: Mapping, path: str | os.PathLike) -> Path:
     return Path(path)
 
 
+def _ranking_axis(vals, m: float, sd: float) -> tuple[bool, float]:
+    """Log axis for the ranking figure where its positive values (the gaps and the noise band's
+    lower edge) span more than a factor 20, and the axis's left end (half the smallest)."""
+    pos = [v for v in list(vals) + [m - 2 * sd] if v is not None and v > 0]
+    lo = 0.5 * min(pos) if pos else 0.0
+    return bool(pos) and max(pos) / min(pos) > 20.0, lo
+
+
 def plot_ranking(summary: Mapping, path: str | os.PathLike) -> Path:
     """Held-out gap of the nominal model and of each calibrated candidate (PNG).
 
@@ -342,22 +350,31 @@ def plot_ranking(summary: Mapping, path: str | os.PathLike) -> Path:
     ax = fig.add_subplot()
     y = np.arange(len(names))
     colors = ["0.4"] + [("C2" if r["accepted"] else "C0") for r in R]
-    ax.barh(y, vals, color=colors, zorder=2)
+    m, sd = nom["null_gap_mean"], nom["null_gap_std"] or 0.0
+    # a static load (the static-offset term) can make the nominal gap a hundred times a
+    # correct model's: then a log axis, so the winner's bar and the noise band stay readable
+    log, lo = _ranking_axis(vals, m, sd)
+    if log:
+        ax.set_xscale("log")
+        ax.barh(y, np.asarray(vals, float) - lo, left=lo, color=colors, zorder=2)
+    else:
+        ax.barh(y, vals, color=colors, zorder=2)
     for i, r in enumerate(R, start=1):
         s = r["heldout_gap_after_per_seed"]
         ax.plot([min(s), max(s)], [i, i], color="k", lw=1, zorder=3)
     b = np.array(per_seed[0])
     ax.plot([b.min(), b.max()], [0, 0], color="k", lw=1, zorder=3)
-    m, sd = nom["null_gap_mean"], nom["null_gap_std"] or 0.0
     # the noise band behind the bars, its edges dashed on top so it stays readable
-    ax.axvspan(m - 2 * sd, m + 2 * sd, color="0.85", zorder=0,
+    band = (max(m - 2 * sd, lo) if log else m - 2 * sd, m + 2 * sd)
+    ax.axvspan(*band, color="0.85", zorder=0,
                label="nominal vs nominal (mean +- 2 sd): the noise level")
-    for v in (m - 2 * sd, m + 2 * sd):
+    for v in band:
         ax.axvline(v, color="0.35", lw=0.8, ls="--", zorder=4)
     ax.set_yticks(y)
     ax.set_yticklabels(names, fontsize=8)
     ax.invert_yaxis()
-    ax.set_xlabel("held-out gap: weighted mean of ln(P_sim/P_meas)^2 [-]")
+    ax.set_xlabel("held-out gap: weighted mean of ln(P_sim/P_meas)^2 plus the road-independent "
+                  "terms [-]" + (" (log axis)" if log else ""))
     ax.set_title(f"verdict: {summary['verdict']} ({summary['verdict_confidence']}); green: accepted",
                  fontsize=9)
     # below the axes: inside them it covered the last bar's whisker

@@ -198,3 +198,15 @@ def test_the_report_says_how_far_the_static_offset_is():
     quiet = {"nominal": {"settings": fold(0.4, 0.02)}}
     assert "within noise" in _static_offset_text(quiet) and "+0.2 mm" in _static_offset_text(quiet)
     assert _static_offset_text({"nominal": {"settings": {}}}) == ""
+
+
+def test_the_ranking_figure_goes_log_when_a_static_load_dwarfs_the_noise():
+    """A payload's static offset made a nominal gap of 35.7 against a noise band at 0.15-0.33
+    and a winner at 0.99 (a seen independent-truck drive): on a linear axis the winner's bar and
+    the band are slivers, so above a factor 20 the axis is logarithmic; the embedded drive's
+    0.2-1.9 stays linear."""
+    from diagnosis.report import _ranking_axis
+
+    log, lo = _ranking_axis([35.7, 0.99, 27.8], 0.24, 0.046)
+    assert log and lo == pytest.approx(0.5 * (0.24 - 2 * 0.046))
+    assert _ranking_axis([1.46, 0.42, 1.94], 0.21, 0.031)[0] is False
