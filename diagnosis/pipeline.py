@@ -664,7 +664,7 @@ def load_measured(dataset):
     sig = Signals(t - t[0], {c: np.asarray(drive.channels[c], float) for c in names},
                   {c: drive.units.get(c, "") for c in names}, np.asarray(drive.speed, float),
                   {"dataset": drive.name, "t0": 0.0,
-                   "susp_disp_zero": str(drive.meta.get("susp_disp_zero", "unknown")),
+                   "susp_disp_zero": drive.susp_disp_zero,
                    **({"resampled_from_hz": resampled["from_hz"]} if resampled else {})})
     return drive, sig
 
@@ -1276,9 +1276,6 @@ def stroke_velocity_term(model: TruckModel):
 #: displacement zero at the nominal vehicle at rest (:func:`static_term`); on since 2026-11-27
 #: (night), docs/diagnosis.md "The static offset"
 STATIC_TERM = True
-#: the dataset declaration that makes the mean suspension displacement evidence
-#: (``meta.toml [dataset] susp_disp_zero``; ``drives.format.SUSP_DISP_ZERO``)
-STATIC_ZERO = "nominal_static"
 
 
 def static_term(model: TruckModel, sig: Signals):
@@ -1287,11 +1284,21 @@ def static_term(model: TruckModel, sig: Signals):
     be the nominal vehicle at rest (``sig.meta["susp_disp_zero"]``); else None (a sensor zeroed
     on the laden truck, or an unknown zero, says nothing about the static load)."""
     from diagnosis.which import StaticOffsetTerm
+    from drives.format import ZERO_NOMINAL_STATIC
 
-    if not STATIC_TERM or (sig.meta or {}).get("susp_disp_zero") != STATIC_ZERO:
+    if not STATIC_TERM or (sig.meta or {}).get("susp_disp_zero") != ZERO_NOMINAL_STATIC:
         return None
     ch = [c for c in model.channels if c.startswith("susp_disp_")]
     return StaticOffsetTerm(ch) if ch else None
+
+
+def gap_terms(model: TruckModel, sig: Signals) -> list:
+    """The road-independent terms of the gap, fresh instances (each holds its prepared
+    statistics): delay, shape, transmissibility, stroke velocity, static offset (None where
+    off).  One list for the ranking (:func:`diagnose`, one per fold) and
+    :func:`heldout_shrink`, so a term added here reaches both."""
+    return [delay_term(model), shape_term(model), transmissibility_term(model),
+            stroke_velocity_term(model), static_term(model, sig)]
 
 
 def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: int = 4,
@@ -1315,8 +1322,7 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
                   n_windows=n_windows)
     sc = _Scorer(Fit(ctx.model), Simulate(ctx.model), ctx.calib, ctx.held, seed, 1, n_seeds,
                  None, None)
-    terms = [delay_term(ctx.model), shape_term(ctx.model), transmissibility_term(ctx.model),
-             stroke_velocity_term(ctx.model), static_term(ctx.model, sig)] if delay else []
+    terms = gap_terms(ctx.model, sig) if delay else []
     surrogates = _set_terms(sc, terms, n_null)
     sc.set_null(surrogates)
     g0, m0 = sc.heldout_scores({})
@@ -1652,13 +1658,12 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
              + (", two folds: then the roles swapped)" if folds == 2 else ")"))
     splits = [(calib, held, seed)] + ([(held, calib, seed + 1)] if folds == 2 else [])
     try:
-        rankings = [rank_effects(cands, fit, simulate, c, h, seed=sd, executor=ex,
-                                 progress=progress, delay=delay_term(model),
-                                 shape=shape_term(model),
-                                 extra_terms=[transmissibility_term(model), stroke_velocity_term(model),
-                                              static_term(model, sig)],
-                                 task_order=TASK_ORDER, **kw)
-                    for c, h, sd in splits]
+        rankings = []
+        for c, h, sd in splits:
+            d_term, s_term, *extra = gap_terms(model, sig)
+            rankings.append(rank_effects(cands, fit, simulate, c, h, seed=sd, executor=ex,
+                                         progress=progress, delay=d_term, shape=s_term,
+                                         extra_terms=extra, task_order=TASK_ORDER, **kw))
         ranking = rankings[0] if folds == 1 else combine_folds(rankings, candidates=cands)
         timing["ranking_s"] = _time.perf_counter() - t
         # the winner's signature: its axle-to-body transmissibility on the

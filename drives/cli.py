@@ -114,6 +114,8 @@ def _help(parser: argparse.ArgumentParser) -> int:
 
 def format_summary(s: dict) -> str:
     """Human-readable lines for a :meth:`drives.format.Drive.summary` dict."""
+    from drives.format import ZERO_NOMINAL_STATIC
+
     lines = [
         f"dataset   {s['name']}: valid",
         f"duration  {s['duration_s']:.3f} s ({s['n_samples']} samples, "
@@ -132,7 +134,7 @@ def format_summary(s: dict) -> str:
     if any(c.startswith("susp_disp_") for c in s["channels"]):
         lines.append("disp zero " + ("the nominal vehicle at rest (declared): the mean displacement "
                                      "is evidence of a static load (eroad diagnose uses it)"
-                                     if s.get("susp_disp_zero") == "nominal_static" else
+                                     if s.get("susp_disp_zero") == ZERO_NOMINAL_STATIC else
                                      "unknown: the mean displacement is not used (declare "
                                      "susp_disp_zero = \"nominal_static\" in meta.toml if the "
                                      "sensors were zeroed on the nominal vehicle at rest)"))

@@ -61,6 +61,7 @@ RATE_REL_TOL = 1e-6
 #: evidence, docs/diagnosis.md "The static offset").  ``"unknown"`` (the default): sensors
 #: zeroed on the vehicle as driven, or nobody knows; the mean is not used.
 SUSP_DISP_ZERO = ("nominal_static", "unknown")
+ZERO_NOMINAL_STATIC, ZERO_UNKNOWN = SUSP_DISP_ZERO
 
 #: built-in vehicle ids, used when the ``vehicles`` package ships no parameter files
 BUILTIN_VEHICLES_FALLBACK = ("dump_truck_8x4", "e_tractor")
@@ -257,6 +258,12 @@ class Drive:
         return float(self.n_samples / self.sample_rate_hz)
 
     @property
+    def susp_disp_zero(self) -> str:
+        """Where the suspension displacements read 0 (``[dataset] susp_disp_zero``,
+        :data:`SUSP_DISP_ZERO`; ``"unknown"`` where not declared)."""
+        return str(self.meta.get("susp_disp_zero", ZERO_UNKNOWN))
+
+    @property
     def channel_names(self) -> list[str]:
         """Names of the measured channels (without time and speed)."""
         return list(self.channels.columns)
@@ -337,7 +344,7 @@ class Drive:
             "vehicle_is_file": isinstance(self.vehicle, Path),
             "warnings": list(self.warnings),
             "speed_check": self.speed_check,
-            "susp_disp_zero": str(self.meta.get("susp_disp_zero", "unknown")),
+            "susp_disp_zero": self.susp_disp_zero,
         }
 
 
@@ -760,7 +767,7 @@ def inspect_drive(folder) -> tuple[list[str], Drive | None]:
         if "speed_mps" not in ds and cols is not None and not has_speed_col:
             probs.items[-1] += " (channels.csv has no speed column, so meta must give it)"
         _number(metaf, ds, "start_time_s", probs, required=False)
-        zero = ds.get("susp_disp_zero", "unknown")
+        zero = ds.get("susp_disp_zero", ZERO_UNKNOWN)
         if zero not in SUSP_DISP_ZERO:
             probs.add(metaf, f"[dataset] susp_disp_zero = {zero!r} is not one of "
                       + ", ".join(f'"{z}"' for z in SUSP_DISP_ZERO))

@@ -54,7 +54,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import PchipInterpolator
 
-from drives.format import TRUTH_DIR, _umask, read_drive, write_drive
+from drives.format import TRUTH_DIR, ZERO_NOMINAL_STATIC, _umask, read_drive, write_drive
 from eroad.errors import EroadInputError
 
 #: folder of the built-in scenario files
@@ -925,7 +925,7 @@ def synthesize(cfg: dict, out, *, force: bool = False, src: str = "") -> dict:
     # both truth models zero their outputs at the nominal vehicle's static equilibrium
     # (a payload error sags the mean displacement): say so (drives.format.SUSP_DISP_ZERO)
     meta = {"name": sc["dataset_name"], "sample_rate_hz": fs, "start_time_s": ds_start,
-            "susp_disp_zero": "nominal_static",
+            "susp_disp_zero": ZERO_NOMINAL_STATIC,
             "description": "virtual test drive (eroad synth); what made it is in truth/"}
     if window is not None:
         meta["description"] = (f"virtual test drive (eroad synth), the {window[0]:g}-{window[1]:g} s "
