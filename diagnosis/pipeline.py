@@ -93,16 +93,20 @@ MIN_PIECE_S = 1.5
 #: may be 30 % rougher or smoother; an amplitude-dependent effect must see the road amplitude
 #: the truck saw (a bump stop simulated at a level 30 % low never engages), so models are
 #: simulated on a re-levelled road, then their response re-levelled as every model is.
-#: ``"nominal"`` (since 2026-11-28): every model, the nominal one included, drives the road
-#: at which the NOMINAL model's run matches the measured level piece by piece (factors
-#: squared into Gq; one extra nominal run per window and road seed, cached), so a candidate
-#: at its neutral value is the nominal model, window by window.  ``"nonlinear"`` (until
-#: 2026-11-28): only nonlinear candidates were pre-levelled, each on its own run, the nominal
-#: model not: a bump stop 300 mm away scored 0.34 where the nominal model scored 0.23 on the
-#: same windows (blind case 3 of results/diagnosis_blind/20261127-static-offset-fresh-40),
-#: the nominal model was not in the candidates' family.  ``"own"``: every model on its own
-#: run (twice the simulations); ``"off"``: the fitted road.
-PRE_LEVEL = "nominal"
+#: ``"nested"`` (since 2026-11-28): the nominal model and the linear candidates drive the
+#: road at which the NOMINAL model's run matches the measured level piece by piece (factors
+#: squared into Gq; one extra nominal run per window and road seed, cached); a nonlinear
+#: candidate drives the road at which ITS OWN run does (its amplitude-dependent response
+#: needs its own level: a bump stop that lowers the response on a rough piece would drive a
+#: road too smooth at the nominal level).  A candidate at its neutral value, linear or not,
+#: then is the nominal model, window by window.  ``"nonlinear"`` (until 2026-11-28): the
+#: same for nonlinear candidates but the nominal model and the linear candidates on the
+#: fitted road: a bump stop 300 mm away scored 0.34 where the nominal model scored 0.23 on
+#: the same windows (blind case 3 of results/diagnosis_blind/20261127-static-offset-
+#: fresh-40); the nominal model was not in the nonlinear candidates' family.  ``"nominal"``:
+#: every model on the nominal model's level; ``"own"``: every model on its own (twice the
+#: simulations); ``"off"``: the fitted road.
+PRE_LEVEL = "nested"
 #: the skewness of the suspension displacements is a term of every gap (``shape_term``,
 #: :class:`diagnosis.which.ShapeTerm`): what separates a bump stop from a payload error
 #: with the same spectra (blind case 13: measured skewness -0.4 to -1.1, nominal 0, se 0.13)
@@ -608,14 +612,14 @@ class Simulate:
         from vehicles.effects import EFFECTS
 
         try:
-            if PRE_LEVEL == "nominal":
+            nonlinear = any(EFFECTS[n].nonlinear for n in effects if n in EFFECTS)
+            if PRE_LEVEL == "own" or (PRE_LEVEL in ("nested", "nonlinear") and nonlinear):
+                return self.prelevel_gq(w, t0, t1, seed, effects)
+            if PRE_LEVEL in ("nested", "nominal"):
                 key = (round(t0, 6), round(t1, 6), int(seed))
                 if key not in self._levels:
                     self._levels[key] = self.prelevel_gq(w, t0, t1, seed, {})
                 return self._levels[key]
-            if PRE_LEVEL == "own" or (PRE_LEVEL == "nonlinear" and any(
-                    EFFECTS[n].nonlinear for n in effects if n in EFFECTS)):
-                return self.prelevel_gq(w, t0, t1, seed, effects)
         except SimulationError:     # the scored run below diverges too, or runs unlevelled
             pass
         return None

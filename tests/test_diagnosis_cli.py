@@ -157,15 +157,17 @@ def test_per_model_nuisances_tilt_and_noise():
     assert all(v == pytest.approx(0.05, rel=0.15) for v in est.values())
 
 
-def test_prelevel_gives_every_model_the_nominal_road_level(short_drive):
-    """``PRE_LEVEL = "nominal"``: every model drives the road level the nominal model needs
-    in that window.  Measured here = 2 x the nominal run on the same road phases, so the
-    pre-levelled Gq must be 4 x the fitted Gq in every segment the window crosses (the
-    model is linear and the phases identical: only the multibody model's geometric
+def test_prelevel_gives_linear_models_the_nominal_level_and_nonlinear_ones_their_own(short_drive):
+    """``PRE_LEVEL = "nested"``: the nominal model and a linear candidate drive the road level
+    the nominal model needs in that window; a nonlinear candidate the level its own run
+    needs.  Measured here = 2 x the nominal run on the same road phases, so the nominal
+    model's pre-levelled Gq must be 4 x the fitted Gq in every segment the window crosses
+    (the model is linear and the phases identical: only the multibody model's geometric
     nonlinearity, ~1e-4, and the tilt refit, exactly 0 for a scaled copy, separate them;
     tolerance 1 %; noise floor set to 0, else the level is that of measured power less
     the noise power).  The nominal run that sets the level is made once per window and
-    road seed: a linear and a nonlinear candidate then run once each, on that level."""
+    road seed (then cached): the payload runs once, on it; the bump stop twice, on the
+    fitted road, then on its own level."""
     import dataclasses
 
     import numpy as np
@@ -193,25 +195,28 @@ def test_prelevel_gives_every_model_the_nominal_road_level(short_drive):
         return real_run(effects, a, b, seed, gq=gq)
 
     m.run = spy
+    stop = {"bump_stop": {"gap": 0.03}}
+    sim(State({}), w, 5)
     sim(State({"payload": {"mass": 1000.0}}), w, 5)
-    sim(State({"bump_stop": {"gap": 0.03}}), w, 5)
-    assert [e for e, _ in calls] == [{}, {"payload": {"mass": 1000.0}},
-                                     {"bump_stop": {"gap": 0.03}}]
-    assert calls[0][1] is None                     # the nominal run on the fitted road
-    for _, g in calls[1:]:
-        np.testing.assert_allclose(g, gq, rtol=1e-12)
+    sim(State(stop), w, 5)
+    assert [e for e, _ in calls] == [{}, {}, {"payload": {"mass": 1000.0}}, stop, stop]
+    assert calls[0][1] is None and calls[3][1] is None          # the runs on the fitted road
+    for _, g in calls[1:3]:
+        np.testing.assert_allclose(g, gq, rtol=1e-12)             # nominal and payload
+    np.testing.assert_allclose(calls[4][1], sim.prelevel_gq(w, t0, t1, 5, stop), rtol=1e-12)
 
 
 def test_a_candidate_at_its_neutral_value_is_the_nominal_model(short_drive):
     """The ranking compares each candidate with the nominal model, so the nominal model must
     be in every candidate's family: a bump stop 0.3 m away (it never engages) scores the
     nominal model's simulation, window by window, including the road level and the
-    re-levelling.  Until 2026-11-28 only nonlinear candidates were pre-levelled and such a
+    re-levelling; a payload of 0 kg is the nominal model exactly.  Until 2026-11-28 only nonlinear candidates were pre-levelled and such a
     bump stop scored 0.34 against the nominal model's 0.23 (docs/diagnosis.md); its run
     differed by ~10 % of the rms.  Tolerance 5e-3 of the channel's rms: the same road and a
     zero stop force, but a nonlinear effect switches the integrator from one linear solve
     per step to Newton iterations, which resolves the geometric nonlinearity the linear
-    scheme drops (measured 1.2e-3 of the rms on susp_disp_1L)."""
+    scheme drops (measured 1.2e-3 of the rms on susp_disp_1L with the nominal model's level;
+    the stop's own level differs from it by the same order)."""
     import numpy as np
 
     from diagnosis.pipeline import Simulate, State, load_measured, prepare
@@ -222,9 +227,10 @@ def test_a_candidate_at_its_neutral_value_is_the_nominal_model(short_drive):
     w = ctx.calib[0]
     a = sim(State({}), w, 7)
     b = sim(State({"bump_stop": {"gap": 0.3}}), w, 7)
+    p = sim(State({"payload": {"mass": 0.0}}), w, 7)
     for c, x in a.channels.items():
-        y = b.channels[c]
-        assert np.max(np.abs(x - y)) <= 5e-3 * np.sqrt(np.mean(x ** 2)), c
+        assert np.max(np.abs(x - b.channels[c])) <= 5e-3 * np.sqrt(np.mean(x ** 2)), c
+        np.testing.assert_array_equal(p.channels[c], x)     # linear: the very same path
 
 
 def test_window_road_has_no_segment_the_truck_does_not_reach(short_drive):
