@@ -600,10 +600,11 @@ class Simulate:
 
     def __init__(self, model: TruckModel):
         self.model = model
-        self._levels = {}       # (t0, t1, seed) -> the nominal model's pre-levelled Gq
-
-    def __getstate__(self):
-        return {"model": self.model, "_levels": {}}
+        # (t0, t1, seed) -> the nominal model's pre-levelled Gq; pickled with the instance,
+        # so the workers of a ranking get the levels of every held-out window and seed the
+        # parent made for the nominal simulations (a level is a function of model, window
+        # and seed alone: which process makes it does not change it)
+        self._levels = {}
 
     def road_level(self, w: Signals, t0: float, t1: float, seed: int, effects) -> np.ndarray | None:
         """Per-segment Gq the model with ``effects`` drives in window [t0, t1), road seed

@@ -206,6 +206,35 @@ def test_prelevel_gives_linear_models_the_nominal_level_and_nonlinear_ones_their
     np.testing.assert_allclose(calls[4][1], sim.prelevel_gq(w, t0, t1, 5, stop), rtol=1e-12)
 
 
+def test_nominal_levels_travel_to_the_workers(short_drive):
+    """The nominal model's per-window levels go with a pickled ``Simulate`` (the ranking's
+    workers get the held-out levels the parent made for the nominal simulations instead of
+    one extra run per window and seed per task), and a level made in another process is the
+    one this process would make (exactly: same model, window and seed)."""
+    import pickle
+
+    import numpy as np
+
+    from diagnosis.pipeline import Simulate, load_measured, prepare
+
+    drive, sig = load_measured(short_drive)
+    ctx = prepare(sig, drive.vehicle, workers=1)
+    sim = Simulate(ctx.model)
+    w = ctx.calib[0]
+    t0 = float(w.meta["t0"])
+    t1 = t0 + w.time.size / ctx.model.fs
+    g = sim.road_level(w, t0, t1, 11, {})
+    copy = pickle.loads(pickle.dumps(sim))
+
+    def no_run(*a, **k):
+        raise AssertionError("the level was made again")
+
+    copy.model.run = no_run
+    np.testing.assert_array_equal(copy.road_level(w, t0, t1, 11, {}), g)
+    fresh = Simulate(pickle.loads(pickle.dumps(ctx.model)))
+    np.testing.assert_array_equal(fresh.road_level(w, t0, t1, 11, {}), g)
+
+
 def test_a_candidate_at_its_neutral_value_is_the_nominal_model(short_drive):
     """The ranking compares each candidate with the nominal model, so the nominal model must
     be in every candidate's family: a bump stop 0.3 m away (it never engages) scores the
