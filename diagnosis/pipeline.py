@@ -93,13 +93,13 @@ MIN_PIECE_S = 1.5
 #: may be 30 % rougher or smoother; an amplitude-dependent effect must see the road amplitude
 #: the truck saw (a bump stop simulated at a level 30 % low never engages), so models are
 #: simulated on a re-levelled road, then their response re-levelled as every model is.
-#: ``"nested"`` (since 2026-11-28): the nominal model and the linear candidates drive the
+#: ``"nested"`` (since stop 42, 2026-11-27): the nominal model and the linear candidates drive the
 #: road at which the NOMINAL model's run matches the measured level piece by piece (factors
 #: squared into Gq; one extra nominal run per window and road seed, cached); a nonlinear
 #: candidate drives the road at which ITS OWN run does (its amplitude-dependent response
 #: needs its own level: a bump stop that lowers the response on a rough piece would drive a
 #: road too smooth at the nominal level).  A candidate at its neutral value, linear or not,
-#: then is the nominal model, window by window.  ``"nonlinear"`` (until 2026-11-28): the
+#: then is the nominal model, window by window.  ``"nonlinear"`` (until stop 42): the
 #: same for nonlinear candidates but the nominal model and the linear candidates on the
 #: fitted road: a bump stop 300 mm away scored 0.34 where the nominal model scored 0.23 on
 #: the same windows (blind case 3 of results/diagnosis_blind/20261127-static-offset-

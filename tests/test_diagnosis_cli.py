@@ -239,9 +239,10 @@ def test_a_candidate_at_its_neutral_value_is_the_nominal_model(short_drive):
     """The ranking compares each candidate with the nominal model, so the nominal model must
     be in every candidate's family: a bump stop 0.3 m away (it never engages) scores the
     nominal model's simulation, window by window, including the road level and the
-    re-levelling; a payload of 0 kg is the nominal model exactly.  Until 2026-11-28 only nonlinear candidates were pre-levelled and such a
-    bump stop scored 0.34 against the nominal model's 0.23 (docs/diagnosis.md); its run
-    differed by ~10 % of the rms.  Tolerance 5e-3 of the channel's rms: the same road and a
+    re-levelling; a payload of 0 kg is the nominal model exactly.  Until stop 42
+    (2026-11-27) only nonlinear candidates were pre-levelled and such a bump stop scored
+    0.34 against the nominal model's 0.23 (docs/diagnosis.md); its run differed by ~10 %
+    of the rms.  Tolerance 5e-3 of the channel's rms: the same road and a
     zero stop force, but a nonlinear effect switches the integrator from one linear solve
     per step to Newton iterations, which resolves the geometric nonlinearity the linear
     scheme drops (measured 1.2e-3 of the rms on susp_disp_1L with the nominal model's level;
