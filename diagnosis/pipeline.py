@@ -103,9 +103,9 @@ MIN_PIECE_S = 1.5
 #: same for nonlinear candidates but the nominal model and the linear candidates on the
 #: fitted road: a bump stop 300 mm away scored 0.34 where the nominal model scored 0.23 on
 #: the same windows (blind case 3 of results/diagnosis_blind/20261127-static-offset-
-#: fresh-40); the nominal model was not in the nonlinear candidates' family.  ``"nominal"``:
-#: every model on the nominal model's level; ``"own"``: every model on its own (twice the
-#: simulations); ``"off"``: the fitted road.
+#: fresh-40); the nominal model was not in the nonlinear candidates' family.  ``"off"``: every
+#: model on the fitted road.  (Every model on the nominal model's level was tried and dropped
+#: before its blind run, docs/diagnosis.md.)
 PRE_LEVEL = "nested"
 #: the skewness of the suspension displacements is a term of every gap (``shape_term``,
 #: :class:`diagnosis.which.ShapeTerm`): what separates a bump stop from a payload error
@@ -613,10 +613,13 @@ class Simulate:
         from vehicles.effects import EFFECTS
 
         try:
-            nonlinear = any(EFFECTS[n].nonlinear for n in effects if n in EFFECTS)
-            if PRE_LEVEL == "own" or (PRE_LEVEL in ("nested", "nonlinear") and nonlinear):
-                return self.prelevel_gq(w, t0, t1, seed, effects)
-            if PRE_LEVEL in ("nested", "nominal"):
+            if PRE_LEVEL not in ("nested", "nonlinear", "off"):
+                raise ValueError(f"PRE_LEVEL must be nested, nonlinear or off, got {PRE_LEVEL!r}")
+            if PRE_LEVEL == "off":
+                return None
+            if any(EFFECTS[n].nonlinear for n in effects if n in EFFECTS):
+                return self.prelevel_gq(w, t0, t1, seed, effects)       # its own level
+            if PRE_LEVEL == "nested":
                 key = (round(t0, 6), round(t1, 6), int(seed))
                 if key not in self._levels:
                     self._levels[key] = self.prelevel_gq(w, t0, t1, seed, {})
