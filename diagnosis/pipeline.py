@@ -58,6 +58,7 @@ speed, discarded).
 """
 from __future__ import annotations
 
+import copy
 import json
 import math
 import os
@@ -606,6 +607,16 @@ class Simulate:
         # and seed alone: which process makes it does not change it)
         self._levels = {}
 
+    def export_cache(self) -> dict:
+        """What this simulator has learnt (the pre-levelled Gq per window and seed), for
+        :func:`diagnosis.which.nominal_sim_sets` to hand from a worker to the parent."""
+        return dict(self._levels)
+
+    def import_cache(self, cache: dict) -> None:
+        """Keep the levels another process made (:meth:`export_cache`)."""
+        for k, v in cache.items():
+            self._levels.setdefault(k, v)
+
     def road_level(self, w: Signals, t0: float, t1: float, seed: int, effects) -> np.ndarray | None:
         """Per-segment Gq the model with ``effects`` drives in window [t0, t1), road seed
         ``seed`` (:data:`PRE_LEVEL`); None: the fitted road."""
@@ -817,7 +828,24 @@ def _low_band_log_ratio(sig: Signals, sim: dict, mask: np.ndarray, names) -> flo
     return _band_share_log_ratio(sig, sim, mask, names, NMIN_LOW_BAND, NMIN_REF_BAND)
 
 
-def fit_nmin(model: TruckModel, sig: Signals, gq, seed: int = 0) -> np.ndarray:
+def _record_run(args):
+    """A noise-free nominal run of the whole record with ``attrs`` set on (a copy of) the
+    model (worker side of :func:`_record_runs`)."""
+    model, attrs, T, seed, gq = args
+    model = copy.copy(model)        # a thread pool shares the caller's model: never set it
+    for name, value in attrs.items():
+        setattr(model, name, value)
+    return model.run({}, 0.0, T, seed, gq=gq)
+
+
+def _record_runs(model: TruckModel, jobs, T: float, gq, mapper=map) -> list:
+    """Nominal whole-record runs ``jobs`` = [(attrs, seed), ...] (``attrs``: model attributes
+    such as ``nmin``, set on a copy for that run only), in parallel when ``mapper`` is an executor's
+    ``map``; each run is seeded on its own, so the result does not depend on who runs it."""
+    return list(mapper(_record_run, [(model, dict(attrs), T, seed, gq) for attrs, seed in jobs]))
+
+
+def fit_nmin(model: TruckModel, sig: Signals, gq, seed: int = 0, mapper=map) -> np.ndarray:
     """Lowest road frequency ``nmin`` per segment, from the grid ``NMIN_GRID``.
 
     One noise-free simulation of the whole record per grid value (all segments at that
@@ -826,7 +854,8 @@ def fit_nmin(model: TruckModel, sig: Signals, gq, seed: int = 0) -> np.ndarray:
     ``NMIN_REF_BAND``, :func:`_low_band_log_ratio`) is closest to the measured share, on
     the whole segment (0.5 s after its start skipped; a low band needs the long record:
     the held-out windows share the road anyway, every model is scored on the same road).
-    Segments without a 512-sample run keep the virtual test drive's 0.1.  The road fit
+    Segments without a 512-sample run keep the virtual test drive's 0.1.  ``mapper``: an
+    executor's ``map`` runs the grid's simulations in parallel.  The road fit
     of the diagnosis thereby leaves w and nmin to the data, as the inversion does (nmax:
     :func:`fit_nmax`, after this one).  Effects that move the body bounce (payload) bias
     this choice; the ranking re-levels, it does not refit nmin.
@@ -842,9 +871,10 @@ def fit_nmin(model: TruckModel, sig: Signals, gq, seed: int = 0) -> np.ndarray:
         m[min(a + int(0.5 * fs), b):b] = True
         masks.append(m)
     d = np.full((len(NMIN_GRID), K), np.nan)
+    runs = _record_runs(model, [({"nmin": np.full(K, nmin)}, seed + 17 * r)
+                                for nmin in NMIN_GRID for r in range(NMIN_SEEDS)], T, gq, mapper)
     for g, nmin in enumerate(NMIN_GRID):
-        model.nmin = np.full(K, nmin)
-        sims = [model.run({}, 0.0, T, seed + 17 * r, gq=gq) for r in range(NMIN_SEEDS)]
+        sims = runs[g * NMIN_SEEDS:(g + 1) * NMIN_SEEDS]
         for k in range(K):
             v = [_low_band_log_ratio(sig, sm, masks[k], names) for sm in sims]
             v = [x for x in v if math.isfinite(x)]
@@ -942,8 +972,8 @@ def _power_log_ratio(pooled, band) -> float:
     return math.log(pm[m].sum() / ps[m].sum())
 
 
-def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | None = None
-             ) -> np.ndarray:
+def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | None = None,
+             mapper=map) -> np.ndarray:
     """Highest road frequency ``nmax`` per segment, from the grid ``NMAX_GRID``.
 
     Two statistics of the axle accelerations (channels ``NMAX_QUANTITIES``, pooled; whole
@@ -983,7 +1013,8 @@ def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | No
     below 20 Hz) would be taken up here.  The ranking re-levels, it does not refit nmax.
 
     ``diag``: if a dict, filled with ``d`` and ``e`` (rows ``NMAX_GRID``, columns segments,
-    NaN where not simulated), the segments' top speeds and the high band.
+    NaN where not simulated), the segments' top speeds and the high band.  ``mapper``: an
+    executor's ``map`` runs the seeds' simulations in parallel.
     """
     fs = sig.fs
     T = sig.time.size / fs
@@ -1004,9 +1035,11 @@ def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | No
     def stat(g, todo, also=None):
         # ``also``: segments without the statistics, driven at the trial cut too (they take
         # a neighbour's value below; left at 5 their road bled into the neighbour's window)
-        model.nmax = np.where(todo if also is None else todo | also, NMAX_GRID[g], ROAD_NMAX)
-        sims = [model.add_noise(model.run({}, 0.0, T, seed + 23 * r, gq=gq), seed + 23 * r + 1)
-                for r in range(NMAX_SEEDS)]
+        nmax = np.where(todo if also is None else todo | also, NMAX_GRID[g], ROAD_NMAX)
+        runs = _record_runs(model, [({"nmax": nmax}, seed + 23 * r) for r in range(NMAX_SEEDS)],
+                            T, gq, mapper)
+        model.nmax = nmax
+        sims = [model.add_noise(sm, seed + 23 * r + 1) for r, sm in enumerate(runs)]
         for k in np.nonzero(todo)[0]:
             pooled = [_pooled_psd(sig, sm, masks[k], names) for sm in sims]   # once for both statistics
             v = [_share_log_ratio(pl, band, NMAX_REF_BAND) for pl in pooled]
@@ -1049,7 +1082,7 @@ def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | No
     return out
 
 
-def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
+def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0, mapper=map):
     """Nominal road level and waviness per segment from calibration samples (one simulation).
 
     The whole record is simulated once on a reference road (``GQ_REF``, ``w = 2``).  Per
@@ -1105,9 +1138,9 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0):
     # re-simulate once with both and re-level
     model.w = w
     if FIT_NMIN:
-        model.nmin = fit_nmin(model, sig, gq, seed)
+        model.nmin = fit_nmin(model, sig, gq, seed, mapper=mapper)
     if FIT_NMAX:
-        model.nmax = fit_nmax(model, sig, gq, seed)
+        model.nmax = fit_nmax(model, sig, gq, seed, mapper=mapper)
     sim2 = model.run({}, 0.0, T, seed, gq=gq)
     for k in range(K):
         a, b = int(round(model.bounds[k] * fs)), int(round(model.bounds[k + 1] * fs))
@@ -1205,14 +1238,15 @@ def inverse_road(sig: Signals, vehicle, workers: int = 2):
 
 
 def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fit: str = "levels",
-            workers: int = 2) -> Context:
+            workers: int = 2, executor=None) -> Context:
     """Segments, noise, calibration/held-out windows, nominal road, and the nominal
     simulation of the whole record (road-phase seed ``seed + 1``, noise-free).
 
     ``road_fit``: ``"levels"`` (default, :func:`fit_road` on the calibration windows) or
     ``"inverse"`` (:func:`inverse_road`, the full inverse fit of the whole record, used
     as it is; the held-out windows then take part in the road fit, which the per-window
-    re-levelling of the ranking does anyway).
+    re-levelling of the ranking does anyway).  ``executor``: a process pool the road fit's
+    independent simulations are spread over (same results as without).
     """
     t = _time.perf_counter()
     noise = noise_std(sig, list(sig.channels))
@@ -1227,7 +1261,8 @@ def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fi
         bounds = road_segments(sig)
         model = TruckModel(vehicle, sig.time, sig.speed, bounds, np.full(len(bounds) - 1, GQ_REF),
                            noise, list(sig.channels), ref_axle=segment_axle(list(sig.channels)))
-        model.gq, model.w = fit_road(model, sig, cal_edges, seed)
+        model.gq, model.w = fit_road(model, sig, cal_edges, seed,
+                                     mapper=executor.map if executor is not None else map)
     else:
         raise EroadInputError(f"road_fit must be 'levels' or 'inverse', got {road_fit!r}")
     T = sig.time.size / sig.fs
@@ -1633,65 +1668,62 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     progress(f"dataset {drive.name}: {sig.duration:.1f} s, {len(sig.channels)} channels, "
              f"vehicle {vp.id}" + (f"; resampled from {sig.meta['resampled_from_hz']:g} to {sig.fs:g} Hz"
                                    if "resampled_from_hz" in sig.meta else ""))
-    ctx = prepare(sig, veh, seed=seed, n_windows=n_windows, road_fit=road_fit, workers=workers)
-    model, calib, held, edges, bounds = ctx.model, ctx.calib, ctx.held, ctx.edges, ctx.bounds
-    cal_edges, simc, segs = ctx.cal_edges, ctx.sim_nominal, ctx.segs
-    timing["road_fit_s"] = ctx.road_fit_s
-    progress(f"road: {len(bounds) - 1} segment(s), Gq(n0) = "
-             + ", ".join(f"{g * 1e6:.3g}" for g in model.gq) + " x 1e-6 m^3, w = "
-             + ", ".join(f"{x:.2f}" for x in model.w)
-             + "".join(f", {lab} = " + ", ".join(f"{x:g}" for x in v)
-                       for lab, v in (("nmin", model.nmin), ("nmax", model.nmax)) if v is not None)
-             + " (calibration windows)")
-
-    # where: nominal over the whole record
-    t = _time.perf_counter()
-    T = sig.time.size / sig.fs
-    sim = Signals(sig.time, model.add_noise(simc, seed + 1), dict(sig.units), sig.speed,
-                  {"model": "nominal"})
-    loc = localize(sig, sim, segments=segs)
-    wheelbase = float(vp.axles[0].x - vp.axles[2].x) if len(vp.axles) >= 3 else None
-    tr = transmissibility(sig, sim)
-    tr2 = two_input_or_none(sig, sim)
-    fr = front_rear_or_none(sig, sim, wheelbase=wheelbase)
-    sh = distribution_shape(sig, sim)
-    timing["localization_s"] = _time.perf_counter() - t
-
-    # which
-    t = _time.perf_counter()
-    names = list(effects) if effects else (list(QUICK_EFFECTS) if quick else None)
-    kw = dict(QUICK_BUDGET) if quick else dict(BUDGET)
-    kw.update(settings or {})
-    folds = int(kw.pop("folds", 1))
-    if folds not in (1, 2):
-        raise EroadInputError(f"folds must be 1 or 2, got {folds}")
-    # pairs are calibrated per fold and not combined: one fold tries them by default
-    kw["pairs"] = bool(kw.get("pairs", True)) and folds == 1
-    fit, simulate = Fit(model), Simulate(model)
+    # one pool for the road fit, the ranking and the signatures; shut down however it ends
     ex = process_pool(workers) if workers and workers > 1 else None
-    # the side of 1 a damper asymmetry is searched on, from its own signature (OWN_SIDE)
-    wants_side = any(n in OWN_SIDE_RANGES for n in (names or OWN_SIDE_RANGES))
     try:
+        ctx = prepare(sig, veh, seed=seed, n_windows=n_windows, road_fit=road_fit, workers=workers,
+                      executor=ex)
+        model, calib, held, edges, bounds = ctx.model, ctx.calib, ctx.held, ctx.edges, ctx.bounds
+        cal_edges, simc, segs = ctx.cal_edges, ctx.sim_nominal, ctx.segs
+        timing["road_fit_s"] = ctx.road_fit_s
+        progress(f"road: {len(bounds) - 1} segment(s), Gq(n0) = "
+                 + ", ".join(f"{g * 1e6:.3g}" for g in model.gq) + " x 1e-6 m^3, w = "
+                 + ", ".join(f"{x:.2f}" for x in model.w)
+                 + "".join(f", {lab} = " + ", ".join(f"{x:g}" for x in v)
+                           for lab, v in (("nmin", model.nmin), ("nmax", model.nmax)) if v is not None)
+                 + " (calibration windows)")
+
+        # where: nominal over the whole record
+        t = _time.perf_counter()
+        T = sig.time.size / sig.fs
+        sim = Signals(sig.time, model.add_noise(simc, seed + 1), dict(sig.units), sig.speed,
+                      {"model": "nominal"})
+        loc = localize(sig, sim, segments=segs)
+        wheelbase = float(vp.axles[0].x - vp.axles[2].x) if len(vp.axles) >= 3 else None
+        tr = transmissibility(sig, sim)
+        tr2 = two_input_or_none(sig, sim)
+        fr = front_rear_or_none(sig, sim, wheelbase=wheelbase)
+        sh = distribution_shape(sig, sim)
+        timing["localization_s"] = _time.perf_counter() - t
+
+        # which
+        t = _time.perf_counter()
+        names = list(effects) if effects else (list(QUICK_EFFECTS) if quick else None)
+        kw = dict(QUICK_BUDGET) if quick else dict(BUDGET)
+        kw.update(settings or {})
+        folds = int(kw.pop("folds", 1))
+        if folds not in (1, 2):
+            raise EroadInputError(f"folds must be 1 or 2, got {folds}")
+        # pairs are calibrated per fold and not combined: one fold tries them by default
+        kw["pairs"] = bool(kw.get("pairs", True)) and folds == 1
+        fit, simulate = Fit(model), Simulate(model)
+        # the side of 1 a damper asymmetry is searched on, from its own signature (OWN_SIDE)
+        wants_side = any(n in OWN_SIDE_RANGES for n in (names or OWN_SIDE_RANGES))
         side_rec, nominal_own_runs, t_side = (own_side_record(model, sig, seed, ex) if wants_side
                                               else (None, None, None))
-    except BaseException:
-        if ex is not None:
-            ex.shutdown()
-        raise
-    if t_side is not None:
-        timing["own_side_s"] = t_side
-    cands = candidates(names, veh, sides=(side_rec or {}).get("sides"))
-    for name, rng in ((side_rec or {}).get("ranges") or {}).items():
-        if rng is not None and any(c.name == name for c in cands):
-            progress(f"{name}: searched over {rng[0]:g}-{rng[1]:g} (the measured "
-                     f"{own_statistic(side_rec['statistic']).name} "
-                     f"{side_rec['measured']:+.3f} against the nominal model's "
-                     f"{np.mean([v for v in side_rec['nominal'] if v is not None]):+.3f})")
-    progress(f"ranking {len(cands)} candidate effect(s) on {len(calib)} calibration + "
-             f"{len(held)} held-out windows ({workers} worker(s)"
-             + (", two folds: then the roles swapped)" if folds == 2 else ")"))
-    splits = [(calib, held, seed)] + ([(held, calib, seed + 1)] if folds == 2 else [])
-    try:
+        if t_side is not None:
+            timing["own_side_s"] = t_side
+        cands = candidates(names, veh, sides=(side_rec or {}).get("sides"))
+        for name, rng in ((side_rec or {}).get("ranges") or {}).items():
+            if rng is not None and any(c.name == name for c in cands):
+                progress(f"{name}: searched over {rng[0]:g}-{rng[1]:g} (the measured "
+                         f"{own_statistic(side_rec['statistic']).name} "
+                         f"{side_rec['measured']:+.3f} against the nominal model's "
+                         f"{np.mean([v for v in side_rec['nominal'] if v is not None]):+.3f})")
+        progress(f"ranking {len(cands)} candidate effect(s) on {len(calib)} calibration + "
+                 f"{len(held)} held-out windows ({workers} worker(s)"
+                 + (", two folds: then the roles swapped)" if folds == 2 else ")"))
+        splits = [(calib, held, seed)] + ([(held, calib, seed + 1)] if folds == 2 else [])
         rankings = []
         for c, h, sd in splits:
             d_term, s_term, *extra = gap_terms(model, sig)

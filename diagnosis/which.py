@@ -919,16 +919,18 @@ class _Scorer:
             [reference(s, self.ref_held.channels, self.ref_held.bands) for s in surrogates]
         self.null_stats = [[t.stats(s) for t in self.terms] for s in surrogates]
 
-    def add_terms(self, terms, nominal_held: list, n: int) -> None:
+    def add_terms(self, terms, nominal_held: list, n: int, nominal_calib: list | None = None) -> None:
         """Prepare ``terms`` on both window sets (sigma from ``nominal_held``, the nominal
         held-out simulations and null surrogates, and from ``n`` nominal calibration
-        simulations, stream 3) and attach them; the weights are set by the caller.  Call
-        before :meth:`set_null`."""
+        simulations, stream 3: ``nominal_calib`` when already made) and attach them; the
+        weights are set by the caller.  Call before :meth:`set_null`."""
         terms = [t for t in terms if t is not None]
         if not terms:
             return
-        state = self.fit({}, self.calib)
-        cal = [self.sims(state, self.calib, 3, i) for i in range(n)]
+        if nominal_calib is None:
+            state = self.fit({}, self.calib)
+            nominal_calib = [self.sims(state, self.calib, 3, i) for i in range(n)]
+        cal = list(nominal_calib)
         for t in terms:
             t.prepare("held", self.heldout, nominal_held)
             t.prepare("calib", self.calib, cal)
@@ -972,6 +974,31 @@ def submission_order(names: Sequence[str], order: Sequence[str] = ()) -> list[in
 def _score_task(args):
     scorer, cands, grid, refine, start = args
     return scorer.score(cands, grid, refine, start)
+
+
+def _sims_task(args):
+    """One nominal simulation set (worker side): ``(sims, cache)``; ``cache`` is what the
+    simulator learnt (``export_cache``, e.g. road levels), for the parent to keep."""
+    scorer, which, stream, i = args
+    windows = scorer.heldout if which == "held" else scorer.calib
+    sims = scorer.sims(scorer.fit({}, windows), windows, stream, i)
+    export = getattr(scorer.simulate, "export_cache", None)
+    return sims, (export() if export is not None else None)
+
+
+def nominal_sim_sets(scorer: "_Scorer", jobs: Sequence[tuple], mapper=map) -> list:
+    """The nominal model's simulation sets ``jobs`` = [(window set "held" | "calib", stream,
+    index), ...], run with ``mapper`` (``executor.map``: in parallel).  The seeds are those of
+    :meth:`_Scorer.sims`, so the sets are the same whichever process runs them; what the
+    workers' simulators learnt (``export_cache``) is handed to the parent's
+    (``import_cache``), so the calibrations sent to the workers afterwards carry it."""
+    out = []
+    imp = getattr(scorer.simulate, "import_cache", None)
+    for sims, cache in mapper(_sims_task, [(scorer, *j) for j in jobs]):
+        if imp is not None and cache:
+            imp(cache)
+        out.append(sims)
+    return out
 
 
 def _nanmean(rows) -> np.ndarray:
@@ -1070,20 +1097,27 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     sc = _Scorer(fit, simulate, calib, heldout, seed, n_calib_seeds, n_seeds, channels, bands)
 
     say("nominal model on held-out data")
-    state0 = fit({}, sc.heldout)
-    nominal_sims = [sc.sims(state0, sc.heldout, 1, i) for i in range(max(n_seeds, n_null))]
-    surrogates = [sc.sims(state0, sc.heldout, 2, i) for i in range(n_null)]
+    mapper = executor.map if executor is not None else map
+    n_nom = max(n_seeds, n_null)
+    terms = [t for t in (delay, shape, *extra_terms) if t is not None]
+    # the nominal simulations (held-out: stream 1, surrogates: stream 2; calibration windows
+    # for the terms' sigma: stream 3) are independent: run in parallel, same seeds as serial
+    sets = nominal_sim_sets(sc, [("held", 1, i) for i in range(n_nom)]
+                            + [("held", 2, i) for i in range(n_null)]
+                            + ([("calib", 3, i) for i in range(n_nom)] if terms else []),
+                            mapper)
+    nominal_sims, surrogates = sets[:n_nom], sets[n_nom:n_nom + n_null]
+    nominal_calib = sets[n_nom + n_null:]
     null_refs = [reference(s, sc.ref_held.channels, sc.ref_held.bands) for s in surrogates]
     null_band = np.array([band_gap(nominal_sims[i], null_refs[i]).value for i in range(n_null)])
     term_info = {}
-    terms = [t for t in (delay, shape, *extra_terms) if t is not None]
     if terms:
         # the terms: sigma from the nominal simulations, weight from the band gap's null
         # spread (each term's null sd = half the band gap's), then part of every gap
         sd_band = float(np.std(null_band, ddof=1)) if null_band.size > 1 else float("nan")
         for t in terms:
             t.weight = (0.5 * sd_band / math.sqrt(2.0)) if np.isfinite(sd_band) else 0.0
-        sc.add_terms(terms, nominal_sims + surrogates, len(nominal_sims))
+        sc.add_terms(terms, nominal_sims + surrogates, len(nominal_sims), nominal_calib=nominal_calib)
         fin = lambda a: [float(x) if np.isfinite(x) else None for x in a]  # noqa: E731
         for t in terms:
             term_info[t.label] = {"sigma_heldout": fin(t._sigma["held"]),
@@ -1123,7 +1157,6 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     say(f"calibrating {len(candidates)} candidates")
     # submitted longest first (task_order), results taken back in the candidates' order
     order = submission_order([c.name for c in candidates], task_order)
-    mapper = executor.map if executor is not None else map
     done = dict(zip(order, mapper(_score_task, [(sc, [candidates[i]], grid, refine, None)
                                                 for i in order])))
     singles = []

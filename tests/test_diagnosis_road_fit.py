@@ -102,3 +102,32 @@ def test_low_nmin_is_found_and_default_kept(tmp_path):
 
     assert share(lo, lambda v: v <= 0.035) > 0.5, list(lo.nmin)
     assert share(hi, lambda v: math.isclose(v, 0.1)) > 0.5, list(hi.nmin)
+
+
+def test_road_fit_on_a_pool_is_the_serial_fit(tmp_path):
+    """``prepare(executor=...)`` spreads the road fit's whole-record runs (the nmin grid, the
+    nmax seeds) over a pool: the fitted road is the serial one, to the last bit (every run is
+    seeded on its own).  The executor pickles each task as a process pool does, so a run that
+    changed the caller's model (``nmin`` set for one grid value) would show.  The drive holds
+    power down to 0.011 cycles/m, so the nmin grid decides something."""
+    import pickle
+
+    import numpy as np
+
+    from diagnosis.pipeline import load_measured, prepare
+
+    class Pickling:
+        n = 0
+
+        def map(self, fn, tasks):
+            tasks = [pickle.loads(pickle.dumps(t)) for t in tasks]
+            Pickling.n += len(tasks)
+            return map(fn, tasks)
+
+    drive, sig = load_measured(_drive(tmp_path, 2.0, 0.011, 2, effects=""))
+    a = prepare(sig, drive.vehicle, workers=1).model
+    b = prepare(sig, drive.vehicle, workers=1, executor=Pickling()).model
+    assert Pickling.n >= 10 + 2                    # the nmin grid (5 x 2 seeds) and nmax's seeds
+    for name in ("gq", "w", "nmin", "nmax"):
+        np.testing.assert_array_equal(getattr(b, name), getattr(a, name))
+    assert min(a.nmin) < 0.1                       # the grid moved nmin
