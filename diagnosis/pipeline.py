@@ -621,14 +621,14 @@ class Simulate:
         """Per-segment Gq the model with ``effects`` drives in window [t0, t1), road seed
         ``seed`` (:data:`PRE_LEVEL`); None: the fitted road."""
         from eroad.errors import SimulationError
-        from vehicles.effects import EFFECTS
+        from vehicles.effects import any_nonlinear
 
         try:
             if PRE_LEVEL not in ("nested", "nonlinear", "off"):
                 raise ValueError(f"PRE_LEVEL must be nested, nonlinear or off, got {PRE_LEVEL!r}")
             if PRE_LEVEL == "off":
                 return None
-            if any(EFFECTS[n].nonlinear for n in effects if n in EFFECTS):
+            if any_nonlinear(effects):
                 return self.prelevel_gq(w, t0, t1, seed, effects)       # its own level
             if PRE_LEVEL == "nested":
                 key = (round(t0, 6), round(t1, 6), int(seed))

@@ -688,9 +688,14 @@ def _static_offset_text(summary: Mapping) -> str:
         return ""
     z = [float(np.mean(f["z_nominal"])) for f in folds]
     part = float(np.mean([f["weight"] * float(np.mean(np.square(f["z_nominal"]))) for f in folds]))
-    # z = mean(rho) sqrt(n / (2 sigma^2)) for equal sigma over the n windows: the offset in m
     offs = []
     for f, zf in zip(folds, z):
+        rho = [x for x in f.get("mean_rho_nominal") or [] if x is not None and np.isfinite(x)]
+        if rho:                 # the offset in m, as the ranking measured it
+            offs.append(float(np.mean(rho)))
+            continue
+        # summaries before 2026-11-27 (stop 43) keep z only: z = mean(rho) sqrt(n / (2 sigma^2))
+        # for equal sigma over the n windows gives the offset in m back
         sig = [x for x in f["sigma_heldout"] if x is not None and np.isfinite(x) and x > 0]
         if sig:
             offs.append(zf * math.sqrt(2.0 / len(sig)) * float(np.sqrt(np.mean(np.square(sig)))))

@@ -1122,7 +1122,11 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
         for t in terms:
             term_info[t.label] = {"sigma_heldout": fin(t._sigma["held"]),
                                   "sigma_calib": fin(t._sigma["calib"]), "weight": t.weight,
-                                  "z_nominal": [t.z(nominal_sims[i], "held") for i in range(n_seeds)]}
+                                  "z_nominal": [t.z(nominal_sims[i], "held") for i in range(n_seeds)],
+                                  # the mismatch itself, in the statistic's unit (a delay in s,
+                                  # a static offset in m), for the report
+                                  "mean_rho_nominal": fin([t.mean_rho(nominal_sims[i], "held")
+                                                           for i in range(n_seeds)])}
             say(f"{t.label} term: sigma {np.round(t._sigma['held'], 4)} per held-out window, "
                 f"weight {t.weight:.3g}, nominal z {np.mean(term_info[t.label]['z_nominal']):+.2f}")
     sc.set_null(surrogates, null_refs)

@@ -184,8 +184,8 @@ def test_verdict_line_gives_the_calibrated_value_with_its_unit_and_folds():
 
 
 def test_the_report_says_how_far_the_static_offset_is():
-    """The static-offset paragraph: the offset in mm from z, the floor and the windows (two
-    windows at the 0.5 mm floor: offset = z * 0.5 mm), its sign in words, and the term's part of
+    """The static-offset paragraph: the offset in mm (recorded by the ranking; from z for older
+    summaries: two windows at the 0.5 mm floor give offset = z * 0.5 mm), its sign in words, and the term's part of
     the nominal gap averaged over the folds as the gap is; nothing without the term."""
     from diagnosis.report import _static_offset_text
 
@@ -198,6 +198,11 @@ def test_the_report_says_how_far_the_static_offset_is():
     quiet = {"nominal": {"settings": fold(0.4, 0.02)}}
     assert "within noise" in _static_offset_text(quiet) and "+0.2 mm" in _static_offset_text(quiet)
     assert _static_offset_text({"nominal": {"settings": {}}}) == ""
+    # a summary that records the mismatch itself (mean_rho_nominal, m) is read, not recovered
+    # from z (windows of unequal sigma make the recovery approximate)
+    f = fold(-40.0, 0.02)
+    f["static offset"].update(mean_rho_nominal=[-0.0121, -0.0119], sigma_heldout=[5e-4, 9e-4])
+    assert "12.0 mm above the measured one" in _static_offset_text({"nominal": {"settings": f}})
 
 
 def test_the_ranking_figure_goes_log_when_a_static_load_dwarfs_the_noise():

@@ -36,7 +36,7 @@ import numpy as np
 
 from eroad.errors import EroadInputError, SimulationError
 from vehicles.builder import SIDE_SIGN, SIDES, _quiet, build_model
-from vehicles.effects import EFFECTS, resolve_effects
+from vehicles.effects import EFFECTS, any_nonlinear, resolve_effects
 from vehicles.effects.base import Effect, EffectContext
 from vehicles.params import VehicleParams, load_vehicle
 from vehicles.result import SimResult, unit_of
@@ -553,7 +553,7 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
     if unilateral:
         prestep, off = unilateral_prestep(model, Q, B, zr, zr_t, kc, cc, dt)
     model.mbs.SetPreStepUserFunction(prestep)
-    nonlinear = any(EFFECTS[n].nonlinear for n in eff) if newton is None else bool(newton)
+    nonlinear = any_nonlinear(eff) if newton is None else bool(newton)
     if newton is None and ctx.chassis == "flexible" and ctx.stiffness_factor > STIFF_FRAME_NEWTON:
         nonlinear = True   # one linear solve per step drifts with extremely stiff joints
     s = exu.SimulationSettings()

@@ -39,6 +39,13 @@ def _discover() -> dict:
 EFFECTS: dict = _discover()
 
 
+def any_nonlinear(effects) -> bool:
+    """True if any of ``effects`` (names, or a ``{name: params}`` dict) is a library effect
+    that makes the model nonlinear (``Effect.nonlinear``); names outside the library (the
+    diagnosis's ``speed_scale``) do not count."""
+    return any(EFFECTS[n].nonlinear for n in effects or () if n in EFFECTS)
+
+
 def get_effect(name: str) -> Effect:
     """The effect called ``name`` (EroadInputError naming the known ones otherwise)."""
     try:
