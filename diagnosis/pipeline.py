@@ -698,13 +698,13 @@ def load_measured(dataset):
     from drives.format import read_drive
 
     drive = read_drive(dataset)
-    from drives.cut import require_moving
+    from drives.cut import require_road_record
     from drives.rate import for_road_methods
     drive, resampled = for_road_methods(drive)   # above the vehicle's solver rate: to 200 Hz
     names = [c for c in drive.channel_names if c.startswith(QUANTITIES)]
     if not names:
         raise EroadInputError(f"{dataset}: no susp_disp/axle_acc/body_acc channels to diagnose")
-    require_moving(drive, "eroad diagnose")   # the road methods run in distance
+    require_road_record(drive, "eroad diagnose")   # the road methods run in distance
     t = np.asarray(drive.time, float)
     sig = Signals(t - t[0], {c: np.asarray(drive.channels[c], float) for c in names},
                   {c: drive.units.get(c, "") for c in names}, np.asarray(drive.speed, float),

@@ -74,6 +74,21 @@ def require_moving(drive, command: str) -> None:
         f"of its own")
 
 
+def require_road_record(drive, command: str) -> None:
+    """Refuse, with one line, a drive the road methods (``command``: "eroad invert", "eroad
+    diagnose", "eroad replica") cannot use: not moving throughout (:func:`require_moving`) or
+    shorter than ``MIN_DURATION`` seconds, the shortest stretch ``eroad data cut`` keeps (a
+    0.25 s record reached the segmentation and stopped there with a traceback; 3 s records
+    invert and diagnose, measured 2026-11-27)."""
+    require_moving(drive, command)
+    t = np.asarray(drive.time, float)
+    dur = float(t[-1] - t[0]) if t.size > 1 else 0.0
+    if dur < MIN_DURATION:
+        raise EroadInputError(
+            f"{drive.path}: {command} needs at least {MIN_DURATION:g} s of record; this one holds "
+            f"{dur:.3g} s ({t.size} samples)")
+
+
 def cut_dataset(src, out, *, window: tuple[float, float] | None = None, moving: bool = False,
                 min_speed: float = MIN_SPEED, min_duration: float = MIN_DURATION,
                 force: bool = False) -> dict:

@@ -958,7 +958,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout="auto", fo
     if out.exists() and any(out.iterdir()) and not force:
         raise EroadInputError(f"{out}: exists and is not empty; choose another --out or use --force")
     drive = read_drive(dataset)
-    from drives.cut import require_moving
+    from drives.cut import require_road_record
     from drives.rate import for_road_methods
     drive, resampled = for_road_methods(drive)   # above the vehicle's solver rate: to 200 Hz
     names = response_channels(drive.channel_names)
@@ -966,7 +966,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout="auto", fo
         raise EroadInputError(f"{drive.path}: eroad replica needs response channels "
                               f"(susp_disp_*, axle_acc_*, body_acc_*); present: "
                               f"{', '.join(drive.channel_names) or 'none'}")
-    require_moving(drive, "eroad replica")   # the road methods run in distance
+    require_road_record(drive, "eroad replica")   # the road methods run in distance
     holdout, holdout_note = _holdout_axle(holdout, names)
     chans = {c: drive.channels[c].to_numpy(float) for c in names}
     lm, left_out, lin_notes = replica_linear_model(drive.vehicle, effects, chans, drive.sample_rate_hz)

@@ -257,12 +257,12 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         raise EroadInputError(f"--segments must be an integer >= 1, got {segments!r}")
     check_out(out, force)
     drive = read_drive(dataset)
-    from drives.cut import require_moving
+    from drives.cut import require_road_record
     from drives.rate import for_road_methods
     drive, resampled = for_road_methods(drive)   # above the vehicle's solver rate: to 200 Hz
     from drives.format import CHANNELS_FILE
     reference_axle(drive.channel_names, f"{drive.path / CHANNELS_FILE}: eroad invert")
-    require_moving(drive, "eroad invert")   # the road methods run in distance
+    require_road_record(drive, "eroad invert")   # the road methods run in distance
     n_cand = int(candidates if candidates is not None else (6 if quick else 16))
     iters = int(max_iter if max_iter is not None else (3 if quick else 12))
     if n_cand < 0 or iters < 1:

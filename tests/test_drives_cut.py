@@ -108,3 +108,30 @@ def test_road_methods_on_a_drive_with_stops_name_them_and_the_cut(stop_drive, tm
         assert main([cmd, str(src), "--out", str(tmp_path / cmd)]) == 2
         err = capsys.readouterr().err
         assert f"eroad {cmd} needs a moving vehicle" in err and "eroad data cut" in err, err
+
+
+def test_road_methods_refuse_a_record_too_short_in_one_line(tmp_path, capsys):
+    """A moving record shorter than ``MIN_DURATION`` (3 s, the shortest stretch ``eroad data
+    cut`` keeps): invert, diagnose and replica each say so in one line, exit 2 and write no run
+    folder (a 0.25 s record used to stop in the segmentation with a traceback).  A record of
+    exactly 3 s passes this check (it inverts and diagnoses, measured on a blind drive cut to
+    3 s)."""
+    from drives.cut import MIN_DURATION, require_road_record
+
+    t = np.arange(25) / FS                       # 0.24 s
+    rng = np.random.default_rng(1)
+    df = pd.DataFrame({"time": t, "susp_disp_3L": 0.01 * rng.standard_normal(t.size),
+                       "susp_disp_3R": 0.01 * rng.standard_normal(t.size),
+                       "axle_acc_3L": rng.standard_normal(t.size),
+                       "axle_acc_3R": rng.standard_normal(t.size), "speed": np.full(t.size, 10.0)})
+    src = write_drive(tmp_path / "short", df, {"vehicle": "dump_truck_8x4"})
+    for cmd in ("invert", "diagnose", "replica"):
+        assert main([cmd, str(src), "--out", str(tmp_path / cmd)]) == 2
+        err = capsys.readouterr().err
+        assert f"eroad {cmd} needs at least 3 s of record; this one holds 0.24 s (25 samples)" in err
+        assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+        assert not (tmp_path / cmd).exists()
+    t3 = np.arange(int(MIN_DURATION * FS) + 1) / FS
+    df3 = pd.DataFrame({"time": t3, "axle_acc_3L": np.zeros(t3.size), "speed": np.full(t3.size, 10.0)})
+    require_road_record(read_drive(write_drive(tmp_path / "three", df3, {"vehicle": "dump_truck_8x4"})),
+                        "eroad invert")
