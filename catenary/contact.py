@@ -309,6 +309,16 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
     _check_line_range(line, x_start, x_end)
     if not (speed > 0 and math.isfinite(speed)):
         raise EroadInputError(f"speed must be positive, got {speed}")
+    c_wave = line.params.contact.wave_speed
+    if speed >= c_wave:
+        # at and above the contact wire's wave speed the moving load has no steady response
+        # (the closed form's amplitude grows without bound as v -> c); design practice keeps
+        # the speed below 70 % of it (EN 50119)
+        raise EroadInputError(
+            f"speed {speed * 3.6:.0f} km/h is at or above the contact wire's wave speed "
+            f"sqrt(T / rho_A) = {c_wave * 3.6:.0f} km/h ({line.params.name}): the contact problem "
+            f"has no steady solution there; lines are designed for at most 70 % of it "
+            f"({0.7 * c_wave * 3.6:.0f} km/h)")
     if not (contact_stiffness > 0 and math.isfinite(contact_stiffness)):
         raise EroadInputError(f"contact stiffness must be positive, got {contact_stiffness}")
     n_steps = int(math.floor((x_end - x_start) / speed / dt + 1e-9))

@@ -53,6 +53,12 @@ def _mounts(text: str) -> tuple:
     return _factor_list(text, False)
 
 
+#: the options that shape a drive (``--road``) and their defaults: given without a road (the
+#: railway reference alone) they would be ignored, so they are refused there
+DRIVE_ONLY = {"speed_kmh": 80.0, "duration": 30.0, "line": "truck_ohl", "pantograph": "truck",
+              "chassis": "flexible", "frame_factor": 1.0, "mount_factor": 1.0, "dt": 1e-3}
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``eroad pantograph-contact`` to the top-level subparsers."""
     from studies.sweep import add_sweep_arguments
@@ -67,19 +73,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--road", metavar="FILE", help="road file (.npz or .crg)")
     p.add_argument("--out", required=True, metavar="DIR",
                    help="results root; the run goes to DIR/pantograph_contact/<run-id>/")
-    p.add_argument("--speed-kmh", type=_positive, default=80.0, help="speed [km/h] (default 80)")
-    p.add_argument("--duration", type=_positive, default=30.0,
+    p.add_argument("--speed-kmh", type=_positive, default=DRIVE_ONLY["speed_kmh"],
+                   help="speed [km/h] (default 80)")
+    p.add_argument("--duration", type=_positive, default=DRIVE_ONLY["duration"],
                    help="drive [s] (default 30; shortened to what the road covers)")
-    p.add_argument("--line", default="truck_ohl",
+    p.add_argument("--line", default=DRIVE_ONLY["line"],
                    help="contact line id or TOML file (default truck_ohl)")
-    p.add_argument("--pantograph", default="truck",
+    p.add_argument("--pantograph", default=DRIVE_ONLY["pantograph"],
                    help="pantograph id or TOML file (default truck)")
-    p.add_argument("--chassis", choices=("flexible", "rigid"), default="flexible")
-    p.add_argument("--frame-factor", type=_positive, default=1.0,
+    p.add_argument("--chassis", choices=("flexible", "rigid"), default=DRIVE_ONLY["chassis"])
+    p.add_argument("--frame-factor", type=_positive, default=DRIVE_ONLY["frame_factor"],
                    help="frame stiffness factor [-] (default 1)")
-    p.add_argument("--mount-factor", type=_positive, default=1.0,
+    p.add_argument("--mount-factor", type=_positive, default=DRIVE_ONLY["mount_factor"],
                    help="DCDC mount stiffness factor [-] (default 1)")
-    p.add_argument("--dt", type=_positive, default=1e-3, help="contact time step [s] (default 1e-3)")
+    p.add_argument("--dt", type=_positive, default=DRIVE_ONLY["dt"], help="contact time step [s] (default 1e-3)")
     p.add_argument("--no-compare", action="store_true",
                    help="skip the run with the pantograph base at rest")
     p.add_argument("--railway-reference", action="store_true",
@@ -123,6 +130,15 @@ def _run(args: argparse.Namespace) -> int:
 
     if args.chassis_grid:
         return _run_grid(args)
+    if args.road is None:
+        given = [k for k, v in DRIVE_ONLY.items() if getattr(args, k) != v]
+        if given:
+            from eroad.errors import EroadInputError
+
+            raise EroadInputError(
+                f"{', '.join('--' + k.replace('_', '-') for k in given)}: options of a drive "
+                f"(--road FILE); the railway reference runs its own line and pantograph at 250 "
+                f"and 300 km/h")
     kw = {}
     if args.road is not None:
         kw = dict(speed_kmh=args.speed_kmh, duration=args.duration, line=args.line,

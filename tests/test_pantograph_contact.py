@@ -137,6 +137,32 @@ def test_cli_needs_a_road_or_reference(tmp_path, capsys):
     assert not any(tmp_path.iterdir())  # nothing written for a refused input
 
 
+def test_speed_at_or_above_the_wave_speed_is_refused(short_line, pant):
+    """At and above the contact wire's wave speed sqrt(T / rho_A) the moving load has no
+    steady response: refused with one line that gives the wave speed and the 70 % design
+    limit; just below it the integrator is entered (a 2-step travel)."""
+    c = short_line.params.contact.wave_speed
+    for v in (c, 1.5 * c):
+        with pytest.raises(EroadInputError, match=rf"at or above the contact wire's wave speed "
+                                                  rf"sqrt\(T / rho_A\) = {c * 3.6:.0f} km/h"):
+            simulate_contact(short_line, collector(pant), speed=v, x_start=50.0, x_end=60.0)
+    r = simulate_contact(short_line, collector(pant), speed=0.99 * c, x_start=50.0,
+                         x_end=50.0 + 2.5 * 0.99 * c * 1e-3, dt=1e-3)
+    assert r["force"].size == 3
+
+
+def test_cli_drive_options_without_a_road_are_refused(tmp_path, capsys):
+    """``--speed-kmh`` and the other drive options shape a drive (``--road``); with the railway
+    reference alone they would be silently ignored (900 km/h ran the reference at 250 and 300):
+    refused in one line naming them, nothing written."""
+    code = main(["pantograph-contact", "--out", str(tmp_path / "o"), "--railway-reference",
+                 "--speed-kmh", "900", "--dt", "0.002"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1
+    assert "--speed-kmh, --dt: options of a drive (--road FILE)" in err
+    assert not (tmp_path / "o").exists()
+
+
 def test_cli_unknown_line_refused_before_any_run_folder(tmp_path, capsys):
     road = tmp_path / "road.npz"
     road.write_bytes(b"")  # never read: the line id is checked first
