@@ -155,6 +155,9 @@ SEARCH = {
 OWN_SIDE = True
 #: the search ranges of each side: effect -> (param, range above the neutral value, range below)
 OWN_SIDE_RANGES = {"damper_asymmetry": ("ratio", (1.0, 8.0), (0.2, 1.0))}
+#: effects whose primary parameter sets the static sag (calibrated further on the static
+#: offset where the dataset declares its displacement zero: ``which.Candidate.static_param``)
+STATIC_PARAM_EFFECTS = ("payload",)
 #: parameters held fixed in the candidates (the sensor's noise is part of the nominal model)
 FIXED = {"sensor": {"acc_noise": 0.0, "disp_noise": 0.0}}
 #: smallest speed factor (recorded / true speed) a simulation may use: every road is made
@@ -1185,7 +1188,8 @@ def candidates(names=None, vehicle=None, sides=None):
         fixed.update(FIXED.get(name, {}))
         out.append(Candidate(name, (Param(pname, float(lo), float(hi),
                                           log=(lo > 0 and hi / lo >= 10)),), fixed,
-                             delay_factor=(name == "speed_scale")))
+                             delay_factor=(name == "speed_scale"),
+                             static_param=(name in STATIC_PARAM_EFFECTS)))
     return out
 
 

@@ -507,3 +507,47 @@ def test_transmissibility_term_reads_the_body_gain():
     rho = term._rho(sim, meas)
     assert rho[0] == pytest.approx(np.log(1.5), abs=0.02)
     assert np.isnan(rho[1])
+
+
+def test_a_payload_is_refined_on_the_static_offset_and_only_where_the_gap_falls():
+    """``refine_from_static``: secant steps on the static-offset mismatch (about linear in the
+    mass: 2.3 mm per tonne, with a small curvature) take a payload searched to 6870 kg to the
+    7676 kg that zeroes it (within 10 kg: the curvature after two steps), and the result is kept
+    because the whole objective (here lowest at 7676 too) falls.  Where the objective prefers
+    another mass (its minimum at 5000 kg, where the search left it) the refinement is dropped
+    and the search's result stands; a zero beyond the range is clipped to its edge."""
+    from diagnosis.which import Calibration, _Scorer
+
+    cand = Candidate("payload", (Param("mass", -16000.0, 16000.0),), {"dx": 0.0})
+
+    class Stub:
+        n_calls = 0
+
+        def __init__(self, m_zero, m_gap):
+            self.m_zero, self.m_gap = m_zero, m_gap
+
+        def static_rho(self, eff):
+            Stub.n_calls += 1
+            d = eff["payload"]["mass"] - self.m_zero
+            assert eff["payload"]["dx"] == 0.0                 # the fixed parameters travel
+            return 2.3e-6 * d + 2e-11 * d * d
+
+        def calib_gap(self, eff):
+            return 0.25 + ((eff["payload"]["mass"] - self.m_gap) / 3000.0) ** 2
+
+    def start(stub, m):
+        eff = {"payload": {"dx": 0.0, "mass": m}}
+        return Calibration(eff, (0.0,), stub.calib_gap(eff), 7, [(eff, stub.calib_gap(eff))])
+
+    stub = Stub(7676.0, 7676.0)
+    cal = _Scorer.refine_from_static(stub, cand, start(stub, 6870.0))
+    assert cal.effects["payload"]["mass"] == pytest.approx(7676.0, abs=10.0)
+    assert cal.calib_gap < start(stub, 6870.0).calib_gap and cal.n_evals == 7 + 2 + 2 + 1
+    assert cal.effects["payload"]["dx"] == 0.0
+    stub = Stub(7676.0, 5000.0)
+    cal = _Scorer.refine_from_static(stub, cand, start(stub, 5000.0))
+    assert cal.effects["payload"]["mass"] == 5000.0                    # kept the search's
+    assert len(cal.history) == 2 and cal.history[-1][0]["payload"]["mass"] == pytest.approx(7676.0, abs=10.0)
+    stub = Stub(20000.0, 20000.0)
+    cal = _Scorer.refine_from_static(stub, cand, start(stub, 12000.0))
+    assert cal.effects["payload"]["mass"] == 16000.0                   # clipped to the range
