@@ -205,7 +205,11 @@ def test_nominal_simulations_run_on_the_pool_and_their_cache_comes_back():
     sc_pool = _Scorer(toy.fit, _CachingSimulate(), calib, held, 4, 1, 2, None, None)
     sc_here = _Scorer(toy.fit, _CachingSimulate(), calib, held, 4, 1, 2, None, None)
     a = nominal_sim_sets(sc_pool, jobs, Pickling().map)
-    b = nominal_sim_sets(sc_here, jobs)
+    # the serial sets, made directly (not through nominal_sim_sets)
+    b = []
+    for which, stream, i in jobs:
+        ws = sc_here.heldout if which == "held" else sc_here.calib
+        b.append(sc_here.sims(toy.fit({}, ws), ws, stream, i))
     assert Pickling.calls == [("_sims_task", 3)]
     assert len(a) == 3 and all(len(s) == 2 for s in a)
     for sa, sb in zip(a, b):
