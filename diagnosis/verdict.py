@@ -769,7 +769,7 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     conf = rd.get("confidence", "clear")
     reason = rd.get("reason") or ""
     reason += (f"; it explains {share:.0%} of the gap above a correct model's"
-               + ("" if agrees is None or remainder or own_res is not None else
+               + ("" if agrees is not True or remainder or own_res is not None else
                   f"; its {what} agrees with the measurement")
                + remainder)
     if own_res is not None:

@@ -195,6 +195,8 @@ def test_whole_gap_is_named_on_the_gap_alone_never_clear():
     assert d["verdict"] == "leaf_friction" and d["confidence"] == "ambiguous"
     assert d["identified"] is False and d["signature_agrees"] is False
     assert "gap alone" in d["reason"] and "no correction" in d["reason"]
+    # the reason does not also say the transmissibility agrees (it read "agrees ... stays off")
+    assert "agrees with the measurement" not in d["reason"]
     from diagnosis.closed_loop import effects_from_diagnosis
     assert effects_from_diagnosis({**_summary(after=0.45, chi2=off), "verdict": d["verdict"],
                                    "verdict_confidence": d["confidence"], "verdict_detail": d})[0] is None
