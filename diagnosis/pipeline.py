@@ -1415,14 +1415,14 @@ def _set_terms(sc, terms, n_null: int) -> list:
     and weight ``rank_effects`` would set; returns the ``n_null`` surrogate measurements
     (stream 2)."""
     from diagnosis.gap import band_gap, reference
+    from diagnosis.which import nominal_sim_sets
 
-    state0 = sc.fit({}, sc.heldout)
-    sur = [sc.sims(state0, sc.heldout, 2, i) for i in range(n_null)]
+    sur = nominal_sim_sets(sc, [("held", 2, i) for i in range(n_null)])
     terms = [t for t in terms if t is not None]
     if not terms:
         return sur
     n = max(sc.n_seeds, n_null)
-    nom = [sc.sims(state0, sc.heldout, 1, i) for i in range(n)]
+    nom = nominal_sim_sets(sc, [("held", 1, i) for i in range(n)])
     nb = [band_gap(nom[i], reference(sur[i], sc.ref_held.channels, sc.ref_held.bands)).value
           for i in range(n_null)]
     for t in terms:
