@@ -1415,7 +1415,7 @@ def _set_terms(sc, terms, n_null: int) -> list:
     and weight ``rank_effects`` would set; returns the ``n_null`` surrogate measurements
     (stream 2)."""
     from diagnosis.gap import band_gap, reference
-    from diagnosis.which import nominal_sim_sets
+    from diagnosis.which import nominal_sim_sets, term_weight
 
     sur = nominal_sim_sets(sc, [("held", 2, i) for i in range(n_null)])
     terms = [t for t in terms if t is not None]
@@ -1425,8 +1425,9 @@ def _set_terms(sc, terms, n_null: int) -> list:
     nom = nominal_sim_sets(sc, [("held", 1, i) for i in range(n)])
     nb = [band_gap(nom[i], reference(sur[i], sc.ref_held.channels, sc.ref_held.bands)).value
           for i in range(n_null)]
+    w = term_weight(nb)
     for t in terms:
-        t.weight = 0.5 * float(np.std(nb, ddof=1)) / math.sqrt(2.0)
+        t.weight = w
     sc.add_terms(terms, nom + sur, n)
     return sur
 

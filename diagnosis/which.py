@@ -1022,6 +1022,17 @@ class _Scorer:
 
 
 
+def term_weight(null_band) -> float:
+    """The weight of every extra gap term (delay, shape, static offset, ...): its null sd is
+    half the band gap's, i.e. ``0.5 sd(null band gaps) / sqrt(2)``; 0 (the terms off) where
+    that sd is undefined (fewer than two null gaps, or one not finite).  The one rule
+    :func:`rank_effects` and the benchmark's oracle (``diagnosis.pipeline._set_terms``) weight
+    the terms by."""
+    nb = np.asarray(null_band, dtype=float).ravel()
+    sd = float(np.std(nb, ddof=1)) if nb.size > 1 else float("nan")
+    return 0.5 * sd / math.sqrt(2.0) if np.isfinite(sd) else 0.0
+
+
 def submission_order(names: Sequence[str], order: Sequence[str] = ()) -> list[int]:
     """Indices of ``names`` in the order their calibrations are handed to the worker pool:
     the names in ``order`` first, in its order (longest first: the caller's measured costs,
@@ -1173,9 +1184,9 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     if terms:
         # the terms: sigma from the nominal simulations, weight from the band gap's null
         # spread (each term's null sd = half the band gap's), then part of every gap
-        sd_band = float(np.std(null_band, ddof=1)) if null_band.size > 1 else float("nan")
+        w = term_weight(null_band)
         for t in terms:
-            t.weight = (0.5 * sd_band / math.sqrt(2.0)) if np.isfinite(sd_band) else 0.0
+            t.weight = w
         sc.add_terms(terms, nominal_sims + surrogates, len(nominal_sims), nominal_calib=nominal_calib)
         fin = lambda a: [float(x) if np.isfinite(x) else None for x in a]  # noqa: E731
         for t in terms:

@@ -555,3 +555,16 @@ def test_a_payload_is_refined_on_the_static_offset_and_only_where_the_gap_falls(
     stub = Stub(20000.0, 20000.0)
     cal = _Scorer.refine_from_static(stub, cand, start(stub, 12000.0))
     assert cal.effects["payload"]["mass"] == 16000.0                   # clipped to the range
+
+
+def test_term_weight_is_half_the_band_gaps_null_sd_over_root_two():
+    """Closed form: null band gaps 1, 2, 3 have sd 1 (ddof 1), so every term weighs
+    0.5 / sqrt(2); an undefined sd (one value, or a NaN) switches the terms off."""
+    import math
+
+    from diagnosis.which import term_weight
+
+    assert term_weight([1.0, 2.0, 3.0]) == pytest.approx(0.5 / math.sqrt(2.0), rel=1e-12)
+    assert term_weight([4.0, 4.0]) == 0.0
+    assert term_weight([1.0]) == 0.0
+    assert term_weight([1.0, float("nan"), 2.0]) == 0.0
