@@ -131,3 +131,76 @@ def test_road_fit_on_a_pool_is_the_serial_fit(tmp_path):
     for name in ("gq", "w", "nmin", "nmax"):
         np.testing.assert_array_equal(getattr(b, name), getattr(a, name))
     assert min(a.nmin) < 0.1                       # the grid moved nmin
+
+
+# fit_nmax's statistics of two blind drives (rows NMAX_GRID 1, 1.5, 2, 2.5, 3, 5 cycles/m;
+# columns segments; NaN: not computed), copied from their road fits (stop 44):
+NAN = float("nan")
+#: our truck with a 6.3 Hz sensor low-pass (20261128-pool-fresh-40, nominal case 9): segments
+#: 2-4 show the high-band deficit as a roll-off (e never below NMAX_CUT_TOL), segment 5, the
+#: smoothest road, looks cut at 2 cycles/m
+SENSOR_D = [[NAN, 5.01, 5.17, -1.08, 1.41, NAN], [NAN, 4.94, 5.64, 0.94, 0.94, NAN],
+            [NAN, -1.7, -1.29, 1.92, -1.77, NAN], [NAN, -2.26, -1.92, 2.11, -2.08, NAN],
+            [NAN, -2.46, -2.08, 2.1, -2.19, NAN], [NAN, -2.62, -2.24, -2.64, -2.29, NAN]]
+SENSOR_E = [[NAN, 7.42, 9.39, 8.82, 3.3, NAN], [NAN, 4.56, 6.06, 6.91, 1.04, NAN],
+            [NAN, 2.82, 4.52, 4.55, 0.49, NAN], [NAN, 1.61, 3.31, 3.0, 0.23, NAN],
+            [NAN, 1.08, 2.61, 1.94, -0.05, NAN], [NAN] * 6]
+
+
+def _low(d):
+    import numpy as np
+
+    from diagnosis.pipeline import NMAX_EVIDENCE, NMAX_GRID, ROAD_NMAX
+
+    d = np.asarray(d, float)
+    g0 = NMAX_GRID.index(ROAD_NMAX)
+    return np.isfinite(d[g0]) & (d[g0] < -NMAX_EVIDENCE)
+
+
+def test_a_roll_off_in_one_segment_leaves_every_segment_uncut():
+    """A sensor low-pass shows in every segment; where the road is smooth its attenuated band
+    sinks into the noise and looks like a cut road.  With the roll-off seen elsewhere, no
+    segment is cut (without the veto segment 5 is cut at 2 cycles/m, as it was)."""
+    import numpy as np
+
+    from diagnosis.pipeline import ROAD_NMAX, choose_nmax
+
+    d, e = np.array(SENSOR_D), np.array(SENSOR_E)
+    out, rolloff, vetoed = choose_nmax(d, e, _low(d))
+    assert vetoed and rolloff == [1, 2, 3]
+    assert np.all(out == ROAD_NMAX)
+    out0, _, vetoed0 = choose_nmax(d, e, _low(d), veto=False)
+    assert not vetoed0 and out0[4] == 2.0 and np.all(np.delete(out0, 4) == ROAD_NMAX)
+
+
+def test_a_road_cut_in_every_segment_is_kept():
+    """A measured profile sampled every 0.25 m holds nothing above 2 cycles/m: every segment
+    with the statistics is cut (second-family case 0 of 20261128-pool-fresh-40; segments 1-2
+    too short, NaN), there is no roll-off, and the cuts stand."""
+    import numpy as np
+
+    from diagnosis.pipeline import choose_nmax
+
+    d = np.full((6, 4), NAN)
+    e = np.full((6, 4), NAN)
+    d[5, 2:] = [-2.24, -4.27]
+    e[:5, 2] = [3.1, 1.2, 0.12, 0.10, 0.16]
+    e[:5, 3] = [2.9, 0.9, 0.15, 0.11, 0.13]
+    out, rolloff, vetoed = choose_nmax(d, e, _low(d))
+    assert not vetoed and rolloff == []
+    assert list(out[2:]) == [2.0, 2.0]
+
+
+def test_a_low_segment_without_any_cut_statistic_is_no_roll_off():
+    """A low segment so fast that no trial cut is visible (every e NaN) says nothing about a
+    roll-off: it does not veto another segment's cut."""
+    import numpy as np
+
+    from diagnosis.pipeline import choose_nmax
+
+    d = np.full((6, 2), NAN)
+    e = np.full((6, 2), NAN)
+    d[5] = [-2.5, -2.5]
+    e[:5, 0] = [2.0, 0.3, 0.2, 0.1, 0.1]
+    out, rolloff, vetoed = choose_nmax(d, e, _low(d))
+    assert rolloff == [] and not vetoed and out[0] == 1.5

@@ -317,3 +317,18 @@ def test_a_speed_error_below_one_percent_is_never_named(factor, named):
         assert f"factor = {factor:.4g}" in d["reason"] and "below the 1%" in d["reason"]
     assert (negligible(e) is None) is named
     assert negligible({"effect": "payload", "parameters": {"payload": {"mass": 1.0}}}) is None
+
+
+def test_a_pooled_null_sd_gives_the_normal_prediction_bound():
+    """Closed form: with a known sd s of ln(mean z^2), the one-sided 0.95 bound of a correct
+    model's signature is exp(mean ln + 1.6449 s sqrt(1 + 1/n)); it never falls below the
+    fixed threshold, and without records the fixed threshold stands."""
+    import math
+
+    from diagnosis.verdict import POOLED_NULL_SD, signature_threshold
+
+    rec = {"chi2_correct_model": [1.0, math.e, math.e ** 2, 1.0]}     # ln: 0, 1, 2, 0
+    want = math.exp(0.75 + 1.6448536 * 0.33 * math.sqrt(1.25))
+    assert signature_threshold(rec, 2.0, 0.95, pooled_sd=POOLED_NULL_SD) == pytest.approx(want, rel=1e-6)
+    assert signature_threshold({"chi2_correct_model": [0.5] * 4}, 2.0, 0.95, pooled_sd=0.33) == 2.0
+    assert signature_threshold({}, 2.0, 0.95, pooled_sd=0.33) == 2.0
