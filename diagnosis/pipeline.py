@@ -372,6 +372,9 @@ class TruckModel:
     #: (``vehicles.simulate(lift_off_expected=True)``, same physics, less time).  Fixed before
     #: the model is sent to the workers, so which path a run takes does not depend on them.
     lift_times: np.ndarray | None = None
+    #: what :func:`fit_nmax` decided about the high band, for the report: ``{"cut": [segment
+    #: indices cut], "rolloff": [segment indices that roll off], "vetoed": bool}``
+    high_band: dict | None = None
 
     def __getstate__(self):
         d = dict(self.__dict__)
@@ -1125,6 +1128,8 @@ def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | No
         for k in np.nonzero(~has)[0]:
             out[k] = out[src[int(np.argmin(np.abs(mid[src] - mid[k])))]]
     model.nmax = out
+    model.high_band = {"cut": [int(k) for k in np.nonzero(out < ROAD_NMAX)[0]],
+                       "rolloff": list(rolloff), "vetoed": bool(vetoed)}
     if diag is not None:
         diag.update(d=d, e=e, vmax=vmax, band=band, rolloff=rolloff, vetoed=vetoed)
     return out
@@ -1822,6 +1827,11 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                            "nmin": float(ROAD_NMIN if model.nmin is None else model.nmin[k]),
                            "nmax": float(ROAD_NMAX if model.nmax is None else model.nmax[k])}
                           for k, s in enumerate(segs)],
+        "road_w_range": list(W_RANGE) if road_fit == "levels" else None,
+        "road_high_band": (None if model.high_band is None else
+                           {"cut": [segs[k][0] for k in model.high_band["cut"]],
+                            "rolloff": [segs[k][0] for k in model.high_band["rolloff"]],
+                            "vetoed": model.high_band["vetoed"]}),
         "road_fit": ("segment level and waviness from the nominal model on the calibration "
                      "windows" if road_fit == "levels" else
                      "inverse.pipeline.invert on the whole record (nominal truck)")

@@ -667,6 +667,7 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                     " (best candidate, NOT accepted)") + ".\n")
         if "shrink" in figures:
             L.append(f"![shrink per band]({figures['shrink']})\n")
+    L.extend(_road_text(summary))
     L.append("## Method\n")
     L.append("Band powers: Welch (Hann, 50 % overlap), exact equivalent degrees of freedom; "
              "intervals from the F distribution of the ratio of two independent chi-square "
@@ -674,6 +675,49 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
              "ISO 18571) are not used: the simulated road is a random-phase realisation, not the "
              "measured one. See docs/diagnosis.md.\n")
     return "\n".join(L)
+
+
+def _road_text(summary: Mapping) -> list:
+    """The road the diagnosis assumed (fitted with the nominal model, every candidate re-levelled
+    on it): one row per segment, and what the fit made of the measured high band."""
+    meta = summary.get("meta") or {}
+    rows = meta.get("road_segments") or []
+    if not rows:
+        return []
+    t0 = float(meta.get("record_t0_s") or 0.0)
+    L = ["## Road the diagnosis assumed\n",
+         "Fitted with the nominal model (" + str(meta.get("road_fit", "")) + "); every candidate "
+         "drives random-phase realisations of it. Gq(n0) at n0 = 0.1 cycles/m; the road holds "
+         "power from nmin to nmax.\n",
+         "| segment | record time [s] | Gq(n0) [m^3] | w | nmin [cycles/m] | nmax [cycles/m] |",
+         "|---|---|---|---|---|---|"]
+    for r in rows:
+        L.append(f"| {r['segment']} | {t0 + r['t_start_s']:.1f}-{t0 + r['t_end_s']:.1f} | "
+                 f"{r['Gq_n0_m3']:.3g} | {r['w']:.2f} | {r['nmin']:g} | {r['nmax']:g} |")
+    wr = meta.get("road_w_range")
+    if wr:
+        at = [r["segment"] for r in rows if min(abs(r["w"] - wr[0]), abs(r["w"] - wr[1])) < 1e-9]
+        if at:
+            L.append(f"\nw at a bound of the fit's range ({wr[0]:g}-{wr[1]:g}) in {', '.join(at)}: "
+                     "the measured spectra tilt further than any road in the range does; a "
+                     "low-pass in the data (or a road rougher in its long waves) shows here, and "
+                     "every candidate re-fits the tilt per window.")
+    hb = meta.get("road_high_band") or {}
+    if hb.get("vetoed"):
+        L.append("\nThe measured high band lies below the road's in " + ", ".join(hb["rolloff"])
+                 + " as a roll-off (power above every trial cut), so no segment is cut: a low-pass "
+                 "of the vehicle or the sensors (tyre enveloping, a sensor low-pass) acts on every "
+                 "segment, and segments that looked cut are too smooth to show it above the noise. "
+                 "The candidates take the roll-off up.")
+    elif hb.get("cut"):
+        L.append("\nCut road (nothing above nmax, the measurement above it is noise) in "
+                 + ", ".join(hb["cut"]) + ": e.g. a measured profile sampled every 0.25 m holds "
+                 "nothing above 2 cycles/m.")
+    elif hb.get("rolloff"):
+        L.append("\nThe measured high band rolls off in " + ", ".join(hb["rolloff"])
+                 + " (no cut): left to the candidates (tyre enveloping, a sensor low-pass).")
+    L.append("")
+    return L
 
 
 def _static_offset_text(summary: Mapping) -> str:

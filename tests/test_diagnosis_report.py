@@ -215,3 +215,26 @@ def test_the_ranking_figure_goes_log_when_a_static_load_dwarfs_the_noise():
     log, lo = _ranking_axis([35.7, 0.99, 27.8], 0.24, 0.046)
     assert log and lo == pytest.approx(0.5 * (0.24 - 2 * 0.046))
     assert _ranking_axis([1.46, 0.42, 1.94], 0.21, 0.031)[0] is False
+
+
+def test_the_report_shows_the_road_the_diagnosis_assumed():
+    """A user comparing with a test drive needs the road the diagnosis drove: one row per
+    segment in record time (Gq, w, nmin, nmax), and what the fit made of the high band -- the
+    road-cut veto in words where it fired, the cut where the road is cut, nothing without a
+    road record (summaries written before it)."""
+    from diagnosis.report import _road_text
+
+    seg = lambda n, a, b, nmax: {"segment": n, "t_start_s": a, "t_end_s": b, "Gq_n0_m3": 2.5e-5,
+                                 "w": 3.0, "nmin": 0.1, "nmax": nmax}
+    meta = {"record_t0_s": 100.0, "road_fit": "levels", "road_w_range": [1.2, 3.0],
+            "road_segments": [seg("S1", 0.0, 10.5, 5.0), seg("S2", 10.5, 30.0, 5.0)],
+            "road_high_band": {"cut": [], "rolloff": ["S1"], "vetoed": True}}
+    txt = "\n".join(_road_text({"meta": meta}))
+    assert "| S2 | 110.5-130.0 | 2.5e-05 | 3.00 | 0.1 | 5 |" in txt
+    assert "in S1 as a roll-off" in txt and "no segment is cut" in txt
+    assert "w at a bound of the fit's range (1.2-3) in S1, S2" in txt
+    meta["road_segments"][1]["nmax"] = 2.0
+    meta["road_high_band"] = {"cut": ["S2"], "rolloff": [], "vetoed": False}
+    txt = "\n".join(_road_text({"meta": meta}))
+    assert "Cut road (nothing above nmax" in txt and "in S2" in txt and "no segment is cut" not in txt
+    assert _road_text({"meta": {}}) == []
