@@ -664,6 +664,8 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                  + ("" if H["is_verdict"] else
                     f" (the ranking's best; the verdict names {v}, see Verdict)"
                     if v not in ("none", "unexplained") else
+                    " (the ranking's best, accepted by the ranking but not named by the verdict: "
+                    "see Verdict)" if _accepted(summary, H["effect"]) else
                     " (best candidate, NOT accepted)") + ".\n")
         if "shrink" in figures:
             L.append(f"![shrink per band]({figures['shrink']})\n")
@@ -675,6 +677,11 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
              "ISO 18571) are not used: the simulated road is a random-phase realisation, not the "
              "measured one. See docs/diagnosis.md.\n")
     return "\n".join(L)
+
+
+def _accepted(summary: Mapping, effect: str) -> bool:
+    """Did the ranking accept ``effect`` (its entry in ``summary["ranking"]``)?"""
+    return any(e.get("effect") == effect and e.get("accepted") for e in summary.get("ranking") or [])
 
 
 def _road_text(summary: Mapping) -> list:

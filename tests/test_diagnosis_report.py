@@ -238,3 +238,20 @@ def test_the_report_shows_the_road_the_diagnosis_assumed():
     txt = "\n".join(_road_text({"meta": meta}))
     assert "Cut road (nothing above nmax" in txt and "in S2" in txt and "no segment is cut" not in txt
     assert _road_text({"meta": {}}) == []
+
+
+def test_how_far_does_not_call_an_accepted_candidate_not_accepted():
+    """Read in a report of a drive answered `unexplained`: the ranking had accepted the sensor
+    (the verdict refused to name it), yet "How far" said "NOT accepted". A saved blind summary
+    of such a drive (pool set, our truck's case 9: tyre enveloping accepted, verdict
+    unexplained) now says what happened."""
+    from pathlib import Path
+
+    from diagnosis.report import render_markdown
+
+    saved = Path(__file__).resolve().parents[1] / "results" / "diagnosis_blind" / \
+        "20261128-pool-fresh-40" / "nominal" / "case009-summary.json"
+    s = json.loads(saved.read_text())
+    txt = render_markdown(s, {})
+    assert "accepted by the ranking but not named by the verdict" in txt
+    assert "NOT accepted" not in txt
