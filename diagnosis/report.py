@@ -424,7 +424,7 @@ def _fmt(v, f="{:.3g}"):
 def _calibrated_value(summary: Mapping, verdict: str) -> str:
     """", calibrated <param> = <value> <unit>" of a named effect's searched parameters (the
     value the ranking holds, and each fold's where there are two); "" for none/unexplained."""
-    entry = next((e for e in summary.get("ranking") or [] if e.get("effect") == verdict), None)
+    entry = _entry(summary, verdict)
     ranges = (summary.get("meta") or {}).get("search_ranges") or {}
     if entry is None:
         return ""
@@ -679,9 +679,14 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
     return "\n".join(L)
 
 
+def _entry(summary: Mapping, effect: str) -> Mapping | None:
+    """The ranking's record of ``effect`` (``summary["ranking"]``), or None."""
+    return next((e for e in summary.get("ranking") or [] if e.get("effect") == effect), None)
+
+
 def _accepted(summary: Mapping, effect: str) -> bool:
-    """Did the ranking accept ``effect`` (its entry in ``summary["ranking"]``)?"""
-    return any(e.get("effect") == effect and e.get("accepted") for e in summary.get("ranking") or [])
+    """Did the ranking accept ``effect``?"""
+    return bool((_entry(summary, effect) or {}).get("accepted"))
 
 
 def _road_text(summary: Mapping) -> list:

@@ -437,8 +437,8 @@ def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_M
     of what the candidate model reaches against its own records on other road phases
     (``chi2_correct_model``, n values): ln values taken as normal, ``exp(m + t_{n-1}(level)
     s sqrt(1 + 1/n))`` with their mean ``m`` and sd ``s`` (one value: that value).  With
-    ``pooled_sd`` the sd is that value instead, known (:data:`SIGNATURE_NULL_SD`, pooled over
-    many drives), and the quantile the normal one: ``exp(m + z(level) pooled_sd sqrt(1 +
+    ``pooled_sd`` the sd is that value instead, known (:data:`POOLED_NULL_SD`, pooled over
+    many drives; used where :data:`SIGNATURE_NULL_SD` is set), and the quantile the normal one: ``exp(m + z(level) pooled_sd sqrt(1 +
     1/n))``.  A model is not held to a standard it would miss if it were right: on a
     four-axle truck the single-input ratio moves with the road's cross-track coherence (4-13
     for the nominal model against itself on one blind drive, docs/diagnosis.md); at 0.95 a
