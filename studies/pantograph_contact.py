@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from catenary.contact import ContactResult, simulate_contact
-from catenary.line import ContactLine, load_line
+from catenary.line import ContactLine, LineParams, load_line
 from catenary.stats import contact_statistics, lateral_statistics
 from eroad.errors import EroadInputError
 
@@ -226,14 +226,16 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
 
 
 def railway_reference(speeds_kmh=(250.0, 300.0), *, dt: float = 5e-4,
-                      line: str | Path = "en50318",
+                      line: str | Path | LineParams = "en50318",
                       pantograph: str | Path = "en50318",
                       analysis_spans: tuple[int, int] = (4, 6)) -> dict[str, Any]:
     """The railway reference case at the given speeds against :data:`REFERENCE_RANGES`.
 
     Runs the pantograph from 5 m to 5 m before the end of the line, statistics over the
     spans ``analysis_spans`` (0-based, end exclusive: (4, 6) = the 5th and 6th of 10, as
-    the benchmark's two central spans), 20 Hz low-pass.
+    the benchmark's two central spans), 20 Hz low-pass.  ``line`` is a built-in id, a TOML
+    file or :class:`catenary.line.LineParams` (a sensitivity study varies one field with
+    :func:`dataclasses.replace`, ``benchmarks/catenary_presag_scan.py``).
 
     Returns
     -------
@@ -242,7 +244,7 @@ def railway_reference(speeds_kmh=(250.0, 300.0), *, dt: float = 5e-4,
     """
     from vehicles.pantograph_model import collector, load_pantograph
 
-    cl = ContactLine(load_line(line))
+    cl = ContactLine(line if isinstance(line, LineParams) else load_line(line))
     col = collector(load_pantograph(pantograph))
     span = cl.params.span
     out: dict[str, Any] = {"line": cl.params.name, "source": cl.params.source, "cases": {}}
