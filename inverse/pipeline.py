@@ -85,6 +85,13 @@ class InversionConfig:
         Key of the uncertainty calibration (:data:`inverse.uncertainty.CALIBRATIONS`,
         :func:`inverse.uncertainty.calibration_key`: fit model and channel set); None: the
         fit model's own (its axle-3 calibration).
+    segment_on : {"axle_acc", "displacement"}
+        What locates the segment boundaries: "axle_acc" (default since 2026-11-28) the
+        octave-band powers of the axle accelerations of the segmentation's wheels
+        (``axle_acc_<a><s>`` beside each ``susp_disp_<a><s>``;
+        :data:`inverse.segmentation.BOUNDARY_BANDS`), falling back to the displacements
+        where a drive lacks one of them; "displacement" the suspension displacements'
+        3-20 Hz power (the method before; docs/inverse.md section 1).
     """
 
     k: int | None = None
@@ -104,6 +111,21 @@ class InversionConfig:
     linear_corrections: int = 2
     model_form: str = "open"
     calibration: str | None = None
+    segment_on: str = "axle_acc"
+
+
+def boundary_channels(channels: dict, segment_channels, segment_on: str = "axle_acc") -> dict | None:
+    """The signals whose band powers locate the boundaries (:func:`inverse.segmentation.segment`):
+    with ``segment_on`` "axle_acc" the axle acceleration at each segmentation wheel when the drive
+    has all of them, else None (the displacements themselves)."""
+    if segment_on not in ("axle_acc", "displacement"):
+        raise EroadInputError(f"segment_on must be 'axle_acc' or 'displacement', got {segment_on!r}")
+    if segment_on == "displacement":
+        return None
+    names = [c.replace("susp_disp_", "axle_acc_", 1) for c in segment_channels]
+    if not names or any(n not in channels for n in names):
+        return None
+    return {n: channels[n] for n in names}
 
 
 #: a fitted parameter this close to a bound is reported as on it (w [-]; ln Gq_n0 [-])
@@ -212,7 +234,8 @@ class Inversion:
                         "polished": any(h.get("kind") == "polish" for h in self.fit.history),
                         "objective": float(self.fit.history[-1]["objective"]),
                         "n_features": int(self.features.n_features().sum())},
-                "segmentation": {"criterion": {str(k): float(v) for k, v in self.segmentation.criterion.items()}},
+                "segmentation": {"criterion": {str(k): float(v) for k, v in self.segmentation.criterion.items()},
+                                 "boundaries_from": self.segmentation.boundary_source},
                 "history": self.fit.history}
 
 
@@ -267,7 +290,9 @@ def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
     if not segment_channels:
         raise EroadInputError("invert: no suspension displacement channel (susp_disp_*) to segment on")
     seg = segment(t, {c: channels[c] for c in segment_channels}, speed, k=config.k,
-                  predict_rms=predict_rms, w_init=config.w0, **config.segmentation)
+                  predict_rms=predict_rms, w_init=config.w0,
+                  boundary_channels=boundary_channels(channels, segment_channels, config.segment_on),
+                  **config.segmentation)
     spec = config.feature_spec
     if spec is None:
         names = sorted(c for c in channels if c.split("_")[0] in ("susp", "axle", "body"))
