@@ -171,3 +171,67 @@ def test_penalised_partition_equals_optimal_partitioning_without_pruning():
             F[t] = np.min(F[tau] + cost(tau, t) + beta)
         got = penalised_partition(y, beta, m, "variance")
         assert np.sum(cost(got[:-1], got[1:])) + beta * (got.size - 2) == pytest.approx(F[n], rel=1e-12, abs=1e-9), seed
+
+
+ACC = ("axle_acc_3L", "axle_acc_3R")
+
+
+def test_one_boundary_series_is_the_single_series_criterion():
+    """A single boundary channel in a single band is the method before, exactly: the same
+    series, its cost scaled by n_eff / n, two parameters per piece -- so the same boundaries
+    and the same penalised cost for every K (to rounding)."""
+    d = _three_segment_drive(2)
+    x = {"susp_disp_3L": d.channels["susp_disp_3L"]}
+    r0 = segment(d.time, x, d.speed)
+    r1 = segment(d.time, x, d.speed, boundary_channels=x, boundary_bands=[(3.0, 20.0)])
+    assert np.array_equal(r0.t_bounds, r1.t_bounds)
+    for key in r0.criterion:
+        assert r1.criterion[key] == pytest.approx(r0.criterion[key], rel=1e-9)
+    assert "3-20 Hz" in r1.boundary_source
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_change_of_waviness_at_one_level_is_found_on_the_axle_accelerations(seed):
+    """Two 12 s pieces at 10 m/s whose spectra cross at 0.4 cycles/m (w 1.6 -> 2.6, levels
+    equal there, i.e. near 4 Hz): the displacements' 3-20 Hz power, dominated by its low end,
+    sees one piece (K = 1 in 5 of 6 seeds measured), the axle accelerations' octave bands see
+    the higher band fall and the lower one rise: K = 2 with the boundary within 0.1 s in 6 of
+    6 (0.05 s is one block of the partitioned series).  The 0.5 s bound is the method's
+    resolution target (docs/inverse.md, section 1)."""
+    from inverse.synthetic import make_drive
+
+    Gq1, w1, w2, n_cross = 256e-6, 1.6, 2.6, 0.4
+    P = np.array([[Gq1, w1, 0.05, 5.0], [Gq1 * (n_cross / 0.1) ** (w2 - w1), w2, 0.05, 5.0]])
+    d = make_drive(P, [12.0, 12.0], speed=10.0, seed=seed)
+    r = segment(d.time, {c: d.channels[c] for c in DISP}, d.speed,
+                boundary_channels={c: d.channels[c] for c in ACC})
+    assert r.n_segments == 2
+    assert abs(r.t_bounds[1] - 12.0) < 0.5
+    assert "axle_acc_3L" in r.boundary_source
+
+
+def test_the_displacements_alone_miss_that_change_of_waviness():
+    """The contrast the test above rests on: the method before (displacements only) answers
+    one piece on most of the same drives."""
+    from inverse.synthetic import make_drive
+
+    Gq1, w1, w2, n_cross = 256e-6, 1.6, 2.6, 0.4
+    P = np.array([[Gq1, w1, 0.05, 5.0], [Gq1 * (n_cross / 0.1) ** (w2 - w1), w2, 0.05, 5.0]])
+    ks = [segment(d.time, {c: d.channels[c] for c in DISP}, d.speed).n_segments
+          for d in (make_drive(P, [12.0, 12.0], speed=10.0, seed=s) for s in range(5))]
+    assert ks.count(1) >= 3
+
+
+def test_boundary_channels_fall_back_to_the_displacements():
+    """inverse.pipeline.boundary_channels: the axle acceleration beside each displacement
+    where the drive has all of them, None (the displacements) where one is missing or when
+    asked for the displacements; an unknown choice is one clear error."""
+    from eroad.errors import EroadInputError
+    from inverse.pipeline import boundary_channels
+
+    ch = {c: np.zeros(3) for c in DISP + ACC}
+    assert set(boundary_channels(ch, DISP)) == set(ACC)
+    assert boundary_channels({k: v for k, v in ch.items() if k != "axle_acc_3R"}, DISP) is None
+    assert boundary_channels(ch, DISP, "displacement") is None
+    with pytest.raises(EroadInputError, match="segment_on"):
+        boundary_channels(ch, DISP, "body")
