@@ -133,7 +133,9 @@ def test_pipeline_on_luliang_like_drive():
     assert rows and all(keys <= set(r) for r in rows)
     assert sum(r["proportion"] for r in rows) == pytest.approx(1.0)
     assert rows[0]["class"] == "A"  # the long smooth first segment (truth 16e-6 m^3)
-    json.dumps(inv.summary())
+    summ = json.loads(json.dumps(inv.summary()))
+    # the boundaries come from the axle accelerations beside the displacements (segment_on default)
+    assert summ["segmentation"]["boundaries_from"].startswith("axle_acc_3L, axle_acc_3R in 6-12")
 
 
 class _PhaseRedrawingSimulator:
