@@ -85,13 +85,15 @@ class InversionConfig:
         Key of the uncertainty calibration (:data:`inverse.uncertainty.CALIBRATIONS`,
         :func:`inverse.uncertainty.calibration_key`: fit model and channel set); None: the
         fit model's own (its axle-3 calibration).
-    segment_on : {"axle_acc", "displacement"}
-        What locates the segment boundaries: "axle_acc" (default since 2026-11-28) the
-        octave-band powers of the axle accelerations of the segmentation's wheels
-        (``axle_acc_<a><s>`` beside each ``susp_disp_<a><s>``;
-        :data:`inverse.segmentation.BOUNDARY_BANDS`), falling back to the displacements
-        where a drive lacks one of them; "displacement" the suspension displacements'
-        3-20 Hz power (the method before; docs/inverse.md section 1).
+    segment_on : {"displacement", "axle_acc"}
+        What locates the segment boundaries: "displacement" (default) the suspension
+        displacements' 3-20 Hz power; "axle_acc" the octave-band powers of the axle
+        accelerations of the segmentation's wheels (``axle_acc_<a><s>`` beside each
+        ``susp_disp_<a><s>``; :data:`inverse.segmentation.BOUNDARY_BANDS`), falling back to
+        the displacements where a drive lacks one of them.  Measured on 245 blind drives
+        (docs/inverse.md, section 1, 2026-11-28): more true boundaries found, G(1 cycle/m)
+        within 20 % not better beyond sampling noise, two segments worse on the
+        independent truck: built, not the default.
     """
 
     k: int | None = None
@@ -111,10 +113,10 @@ class InversionConfig:
     linear_corrections: int = 2
     model_form: str = "open"
     calibration: str | None = None
-    segment_on: str = "axle_acc"
+    segment_on: str = "displacement"
 
 
-def boundary_channels(channels: dict, segment_channels, segment_on: str = "axle_acc") -> dict | None:
+def boundary_channels(channels: dict, segment_channels, segment_on: str = "displacement") -> dict | None:
     """The signals whose band powers locate the boundaries (:func:`inverse.segmentation.segment`):
     with ``segment_on`` "axle_acc" the axle acceleration at each segmentation wheel when the drive
     has all of them, else None (the displacements themselves)."""

@@ -134,8 +134,13 @@ def test_pipeline_on_luliang_like_drive():
     assert sum(r["proportion"] for r in rows) == pytest.approx(1.0)
     assert rows[0]["class"] == "A"  # the long smooth first segment (truth 16e-6 m^3)
     summ = json.loads(json.dumps(inv.summary()))
-    # the boundaries come from the axle accelerations beside the displacements (segment_on default)
-    assert summ["segmentation"]["boundaries_from"].startswith("axle_acc_3L, axle_acc_3R in 6-12")
+    # the summary names what located the boundaries: the displacements by default ...
+    assert summ["segmentation"]["boundaries_from"].startswith("susp_disp_3L, susp_disp_3R in 3-20 Hz")
+    # ... the axle accelerations beside them with segment_on="axle_acc" (the segmentation alone)
+    alt = invert(d.time, d.channels, d.speed, quarter_simulator_factory(d.time, d.speed),
+                 predict_rms=quarter_predict_rms(),
+                 config=InversionConfig(seed=0, segment_on="axle_acc", fit=FitConfig(max_iter=1)))
+    assert alt.summary()["segmentation"]["boundaries_from"].startswith("axle_acc_3L, axle_acc_3R in 6-12")
 
 
 class _PhaseRedrawingSimulator:

@@ -223,16 +223,16 @@ def test_the_displacements_alone_miss_that_change_of_waviness():
 
 
 def test_boundary_channels_fall_back_to_the_displacements():
-    """inverse.pipeline.boundary_channels: the axle acceleration beside each displacement
-    where the drive has all of them, None (the displacements) where one is missing or when
-    asked for the displacements; an unknown choice is one clear error."""
+    """inverse.pipeline.boundary_channels: with segment_on "axle_acc" the axle acceleration
+    beside each displacement where the drive has all of them, None (the displacements) where
+    one is missing and by default; an unknown choice is one clear error."""
     from eroad.errors import EroadInputError
     from inverse.pipeline import boundary_channels
 
     ch = {c: np.zeros(3) for c in DISP + ACC}
-    assert set(boundary_channels(ch, DISP)) == set(ACC)
-    assert boundary_channels({k: v for k, v in ch.items() if k != "axle_acc_3R"}, DISP) is None
-    assert boundary_channels(ch, DISP, "displacement") is None
+    assert set(boundary_channels(ch, DISP, "axle_acc")) == set(ACC)
+    assert boundary_channels({k: v for k, v in ch.items() if k != "axle_acc_3R"}, DISP, "axle_acc") is None
+    assert boundary_channels(ch, DISP) is None          # the default: the displacements
     with pytest.raises(EroadInputError, match="segment_on"):
         boundary_channels(ch, DISP, "body")
 
