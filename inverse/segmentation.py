@@ -436,10 +436,11 @@ def segment(time, channels, speed, *, k=None, k_max: int | None = None, window_s
         displacement's 3-20 Hz power is dominated by its low end (about 0.3 cycles/m at
         10 m/s), so two road pieces whose spectra cross there -- a change of waviness at
         an unchanged level near 0.3 cycles/m -- look alike to it; separate octave bands
-        of the axle acceleration see such a change as opposite moves.  Measured on 60
-        blind `null` drives (docs/inverse.md, section 1): true segments >= 3 s matched
-        by one fitted segment 142 -> 155 of 191, interior boundaries found within 0.5 s
-        119 -> 131 of 162, over-segmented drives 2 -> 4.  Needs ``cost='variance'``.
+        of the axle acceleration see such a change as opposite moves.  Measured on 100
+        blind `null` drives of our truck (docs/inverse.md, section 1): interior boundaries
+        found within 0.5 s 218 -> 230 of 292, but no gain on the independent truck and
+        no road-estimate gain beyond noise, so the inversion does not use it by default
+        (``InversionConfig.segment_on``).  Needs ``cost='variance'``.
     boundary_bands : sequence of (float, float)
         Bands [Hz] of ``boundary_channels`` (default :data:`BOUNDARY_BANDS`); a band
         that reaches the Nyquist frequency is cut to 0.45 fs, one that starts above it
