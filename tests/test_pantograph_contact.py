@@ -171,3 +171,22 @@ def test_cli_unknown_line_refused_before_any_run_folder(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2 and "unknown contact line" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_reference_printout_names_what_is_outside_with_its_range():
+    """The railway reference's printout says in words what lies inside the EN 50318 ranges and
+    gives each value outside with its range (uplift in mm), not a Python dict."""
+    from studies.cli_pantograph_contact import _ref_lines
+
+    case = {"stats": {"mean": 117.9, "sd": 34.2, "stat_max": 220.4, "stat_min": -22.0, "actual_max": 200.0,
+                      "actual_min": 58.3, "max_support_uplift": 0.0425, "loss_percent": 0.0},
+            "ranges": {"mean": [110, 120], "sd": [26, 31], "stat_min": [-5, 20], "max_support_uplift": [0.048, 0.055],
+                       "loss_percent": [0, 0]},
+            "inside": {"mean": True, "sd": False, "stat_min": False, "max_support_uplift": False, "loss_percent": True}}
+    head, line = _ref_lines("250", case)
+    assert head.startswith("reference 250 km/h: mean 117.9 N, sd 34.2 N")
+    assert "2 of 5 (mean, loss)" in line
+    assert "sd 34.2 N (range 26 to 31)" in line
+    assert "Fm-3sd -22.0 N (range -5 to 20)" in line
+    assert "support uplift 42.5 mm (range 48 to 55)" in line
+    assert "{" not in line
