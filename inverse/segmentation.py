@@ -442,9 +442,10 @@ def segment(time, channels, speed, *, k=None, k_max: int | None = None, window_s
         no road-estimate gain beyond noise, so the inversion does not use it by default
         (``InversionConfig.segment_on``).  Needs ``cost='variance'``.
     boundary_bands : sequence of (float, float)
-        Bands [Hz] of ``boundary_channels`` (default :data:`BOUNDARY_BANDS`); a band
-        that reaches the Nyquist frequency is cut to 0.45 fs, one that starts above it
-        is left out.
+        Bands [Hz] of ``boundary_channels`` (default :data:`BOUNDARY_BANDS`), each cut at
+        0.45 fs and at :data:`BOUNDARY_NMAX` cycles/m times the drive's 5th-percentile
+        speed; a band left narrower than :data:`BAND_MIN_RATIO` of its lower edge is
+        left out.
 
     Returns
     -------
@@ -474,6 +475,7 @@ def segment(time, channels, speed, *, k=None, k_max: int | None = None, window_s
     ty = t[: nb * step].reshape(nb, step).mean(axis=1)
     e = (w_init - 1.0) if speed_exponent is None else float(speed_exponent)
     vnorm = (np.maximum(v, 1e-3) / max(float(np.mean(v)), 1e-3)) ** e
+    duration = t[-1] - t[0] + 1.0 / fs
     weights = None
     series_label = f"{', '.join(channels) if isinstance(channels, dict) else 'the signal'} in {f_hp:g}-{f_lp:g} Hz"
     if boundary_channels is not None:
@@ -492,7 +494,6 @@ def segment(time, channels, speed, *, k=None, k_max: int | None = None, window_s
             raise EroadInputError(f"segment: no boundary band below {f_top:g} Hz (0.45 fs and "
                                   f"{BOUNDARY_NMAX:g} cycles/m at the drive's slow end)")
         cols, n_effs = [], []
-        duration = t[-1] - t[0] + 1.0 / fs
         for x in bsigs:
             for a, b in bands:
                 xf = band_pass(x, fs, a, b)
@@ -512,7 +513,6 @@ def segment(time, channels, speed, *, k=None, k_max: int | None = None, window_s
         raise EroadInputError(f"segment: unknown cost {cost!r}, use 'variance' or 'mean'")
     n = y.shape[0]
     min_len = max(1, int(round(min_len_s * fs / step)))
-    duration = t[-1] - t[0] + 1.0 / fs
     if weights is None:
         # one series: the cost is scaled by n_eff / n below, two parameters per piece
         b_eff = float(np.mean([effective_bandwidth(x, fs) for x in filt]))

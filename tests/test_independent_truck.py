@@ -245,6 +245,10 @@ def test_second_family_dataset_is_readable_and_deterministic(tmp_path):
     assert drive is not None
     truth = synth.read_truth(tmp_path / "a")
     opts = truth["vehicle"]["truth"]["independent"]
+    # the out-of-library options are recorded in the truth: the front anti-roll bar's default is
+    # 1.5e5 N m/rad (drives.independent_truck OPTIONS); the band (x0.67 to x2) accepts a
+    # retuned default while catching an unrecorded (0) or unit-slipped value; the rear roll
+    # centre is its default, 0.95 m, exactly
     assert 1.0e5 <= opts["arb_front"] <= 3.0e5 and opts["roll_centre_height_rear"] == 0.95
     assert truth["vehicle"]["simulate_kwargs"]["effects"]["leaf_friction"]["force"] == 2500.0
     # the explicit scenario regenerates the same bytes
