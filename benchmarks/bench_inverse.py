@@ -438,6 +438,8 @@ def main(argv=None) -> int:
                     help="where the synthetic datasets are made or found (default: ROOT); share "
                          "it between runs that compare settings on the same drives")
     ap.add_argument("--no-polish", action="store_true", help="switch off the fit's polishing step")
+    ap.add_argument("--segment-on", default="displacement", choices=["displacement", "axle_acc"],
+                    help="as `eroad invert --segment-on`: what locates the segment boundaries")
     ap.add_argument("--fit", default="linear", choices=["linear", "simulation"],
                     help="the fit's model, as `eroad invert --fit` (each record's fit_model field says which ran)")
     ap.add_argument("--known-noise", action="store_true",
@@ -523,7 +525,8 @@ def main(argv=None) -> int:
                                                 ("body_acc", "body_acc_mps2"))}
         t0 = time.perf_counter()
         inv = dict(workers=a.workers, seed=0, candidates=0, max_iter=a.max_iter, channels=a.channels,
-                   force=True, polish=not a.no_polish, noise_sd=noise, fit_model=a.fit)
+                   force=True, polish=not a.no_polish, noise_sd=noise, fit_model=a.fit,
+                   segment_on=a.segment_on)
         if a.effects_auto:
             from diagnosis.closed_loop import invert_closed_loop
             dg = Path(a.diagnoses) / f"run-{seed}" / "diagnose" if a.diagnoses else None

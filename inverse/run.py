@@ -170,7 +170,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                   force: bool = False, candidates=None, max_iter=None, effects=None, chassis: str = "rigid",
                   channels=None, argv=None, polish: bool = True, noise_sd=None,
                   fit_model: str = "linear", selection: str = "linear", bar=None,
-                  road_model: str = "auto", model_form: str = "open") -> dict:
+                  road_model: str = "auto", model_form: str = "open", segment_on: str = "displacement") -> dict:
     """Invert a dataset into the run folder ``out`` (see the module docstring).
 
     Parameters
@@ -231,6 +231,10 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         The model-form term of the reported intervals (:data:`inverse.uncertainty.MODEL_FORMS`):
         "open" unless the diagnosis found no gap on this drive or named the effect this fit
         carries (``diagnosis.closed_loop`` sets it); recorded in ``summary["fit"]["model_form"]``.
+    segment_on : {"displacement", "axle_acc"}
+        What the segment boundaries are located on (:class:`inverse.pipeline.InversionConfig`):
+        the reference axle's suspension displacements in 3-20 Hz (default) or the octave bands
+        of its axle accelerations; recorded in ``summary["segmentation"]["boundaries_from"]``.
 
     Returns
     -------
@@ -285,7 +289,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     cset = channel_set(list(chans), drive.channel_names)
     ckey, calibrated = calibration_key(fit_model, cset)
     icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd,
-                           fit_model=fit_model, model_form=model_form, calibration=ckey)
+                           fit_model=fit_model, model_form=model_form, calibration=ckey, segment_on=segment_on)
     make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans), ref_axle=ref)
     predict = TruckPredictRms(drive.vehicle, tuple(seg_disp), chassis=chassis, effects=effects)
 

@@ -50,6 +50,7 @@ def test_invert_writes_the_run_and_ignores_truth(short_drive):
     # the lateral structure is a stated assumption with its sensitivity (inverse/lateral.py)
     assert len(s["lateral"]["segments"]) == 2 and "lam=2" in s["lateral"]["factor_range"]
     assert "Lateral road structure assumed" in (run / "tables" / "table1.md").read_text()
+    assert s["segmentation"]["boundaries_from"].startswith("susp_disp_3L, susp_disp_3R in 3-20 Hz")
     rj = json.loads((run / "run.json").read_text())
     assert rj["status"] == "complete"
     assert rj["start_utc"] and rj["end_utc"] and rj["host"]["hostname"] and rj["seed"] == 0
@@ -216,3 +217,17 @@ def test_effect_option_reaches_the_simulation(short_drive, tmp_path):
     for c in chans:
         assert rows[c]["rms_sim"] == pytest.approx(float(np.std(with_effect[c])), rel=1e-9), c
     assert max(abs(math.log(np.std(nominal[c]) / rows[c]["rms_sim"])) for c in chans) > 0.01
+
+
+def test_segment_on_option_reaches_the_segmentation(short_drive, tmp_path):
+    """``eroad invert --segment-on axle_acc``: the boundaries are located on the octave bands of
+    axle 3's accelerations, and summary.json says so (the default run in
+    ``test_invert_writes_the_run_and_ignores_truth`` names the displacements); smoke-size:
+    K = 2, one iteration, serial."""
+    ds, _, _ = short_drive
+    out = tmp_path / "run_axle_acc"
+    assert main(["invert", str(ds), "--out", str(out), "--segment-on", "axle_acc", "--segments", "2",
+                 "--workers", "1", "--max-iter", "1", "--candidates", "0", "--quiet"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["segmentation"]["boundaries_from"].startswith("axle_acc_3L, axle_acc_3R in 6-12")
+    assert len(s["segments"]) == 2
