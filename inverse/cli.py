@@ -50,7 +50,9 @@ def register(subparsers) -> None:
                         "lowest-numbered axle logged on both sides where axle 3 is not), 'axle<N>' (those of "
                         "axle N, e.g. axle3), 'axles' (axle_acc of every axle + that axle's susp_disp; the "
                         "default of --effects auto where the diagnosis finds no gap), 'all' (every response "
-                        "channel), or a comma list")
+                        "channel), 'axle<N>_acc' / 'axles_acc' (the axle accelerations of those sets alone; "
+                        "the displacements only segment the drive), or a comma list (fitted as listed; a "
+                        "displacement pair is added for the segmentation, not fitted)")
     p.add_argument("--effect", action="append", default=[], metavar="NAME[.PARAM]=VALUE",
                    help="effect added to the nominal model (repeatable), e.g. leaf_friction")
     p.add_argument("--effects", choices=("auto",), default=None,

@@ -130,9 +130,14 @@ def channels_note(channel_set: str, calibrated: bool) -> str:
     calibrated for them (``inverse.uncertainty.calibration_key``)."""
     what = {"axles": "axle accelerations of every axle and the suspension displacement of one axle (axle 3 "
                      "where logged)",
-            "all": "every response channel"}.get(channel_set, "a list of the user's")
+            "all": "every response channel",
+            "axles_acc": "axle accelerations of every axle; the suspension displacements only segment the "
+                         "drive"}.get(channel_set, "a list of the user's")
     if channel_set.startswith("axle") and channel_set[4:].isdigit():
         what = f"suspension displacement and axle acceleration of axle {channel_set[4:]}"
+    if channel_set.startswith("axle") and channel_set.endswith("_acc") and channel_set[4:-4].isdigit():
+        what = (f"axle acceleration of axle {channel_set[4:-4]}, both sides; the suspension displacements "
+                f"only segment the drive")
     if calibrated:
         return (f"Fitted channels: '{channel_set}' ({what}); the intervals are calibrated for them (set or "
                 f"checked on blind drives fitted on these channels).")

@@ -37,7 +37,7 @@ import numpy as np
 from eroad.archive import finish_run_info, run_info, write_json_atomic, write_run_json
 from eroad.errors import EroadInputError
 
-__all__ = ["run_inversion", "fit_channels", "axles_channels", "channel_set", "CHANNEL_SETS", "noise_psd_from_sd", "check_out", "headline",
+__all__ = ["run_inversion", "fit_channels", "fit_plan", "axles_channels", "channel_set", "CHANNEL_SETS", "noise_psd_from_sd", "check_out", "headline",
            "AXLE3_CHANNELS", "RUN_FORMAT", "axle_channels", "reference_axle", "paired_axles"]
 
 #: run-folder format version
@@ -74,8 +74,9 @@ PREFERRED_AXLE = 3
 AXLE3_CHANNELS = axle_channels(PREFERRED_AXLE)
 
 
-#: the named channel sets of ``--channels`` besides a comma list ('axle<N>' names any axle)
-CHANNEL_SETS = ("axle3", "axles", "all")
+#: the named channel sets of ``--channels`` besides a comma list ('axle<N>' names any axle;
+#: 'axle<N>_acc' and 'axles_acc' fit the axle accelerations of those sets alone)
+CHANNEL_SETS = ("axle3", "axles", "all", "axle3_acc", "axles_acc")
 
 
 def paired_axles(names) -> list:
@@ -115,23 +116,55 @@ def axles_channels(available) -> list:
 
 
 def channel_set(names, available) -> str:
-    """The name of a fitted channel list: 'axle<N>' (e.g. 'axle3'), 'axles', 'all' when it is
-    that set of the drive ``available``, else 'custom' (the key of its uncertainty
-    calibration, :func:`inverse.uncertainty.calibration_key`)."""
+    """The name of a FITTED channel list (:func:`fit_plan`'s second list): 'axle<N>' (e.g.
+    'axle3'), 'axles', 'all', 'axle<N>_acc', 'axles_acc' when it is that set of the drive
+    ``available``, else 'custom' (the key of its uncertainty calibration,
+    :func:`inverse.uncertainty.calibration_key`)."""
     got = set(names)
     resp = [c for c in available if c.split("_")[0] in ("susp", "axle", "body")]
-    for spec in [f"axle{a}" for a in paired_axles(resp)] + ["axles", "all"]:
-        if got == set(fit_channels(available, spec)):
+    axles = paired_axles(resp)
+    for spec in [f"axle{a}" for a in axles] + ["axles", "all"] + [f"axle{a}_acc" for a in axles] + ["axles_acc"]:
+        fitted = fit_plan(available, spec)[1]
+        if fitted and got == set(fitted):
             return spec
     return "custom"
 
 
+def fit_plan(available, spec) -> tuple[list, list]:
+    """The simulated and the fitted channels of ``--channels spec``.
+
+    The simulated list is :func:`fit_channels`'s (it always holds one axle's suspension
+    displacement on both sides: the segmentation's).  The fitted list -- the channels whose
+    features the fit compares -- is the same, except for 'axle<N>_acc' and 'axles_acc' (the
+    axle accelerations of 'axle<N>' or 'axles' alone) and a comma list, whose channels are
+    fitted as listed: a displacement pair added for the segmentation is simulated, not fitted.
+    """
+    acc = re.fullmatch(r"(axle\d+|axles)_acc", spec) if isinstance(spec, str) else None
+    if acc:
+        sim = fit_channels(available, acc.group(1))
+        fitted = [c for c in sim if c.startswith("axle_acc_")]
+        if not fitted:
+            raise EroadInputError(f"--channels {spec}: the drive logs no axle acceleration of "
+                                  f"{'that axle' if acc.group(1) != 'axles' else 'any axle'}")
+        return sim, fitted
+    sim = fit_channels(available, spec)
+    if isinstance(spec, str) and (spec in CHANNEL_SETS or re.fullmatch(r"axle\d+", spec)) or spec is None:
+        return sim, list(sim)
+    listed = [c.strip() for c in (spec.split(",") if isinstance(spec, str) else spec) if c.strip()]
+    return sim, [c for c in sim if c in listed]
+
+
 def fit_channels(available, spec) -> list:
-    """Fitted channels from ``spec``: None (the default: both sides of the reference axle,
+    """Simulated channels from ``spec``: None (the default: both sides of the reference axle,
     :func:`reference_axle`, i.e. axle 3 where logged), 'axle<N>' (axle N's suspension
-    displacement and axle acceleration), 'axles', 'all' or a comma list / sequence. The list
-    always holds one axle's suspension displacement on both sides (the segmentation's)."""
+    displacement and axle acceleration), 'axles', 'all', 'axle<N>_acc' / 'axles_acc' (as
+    'axle<N>' / 'axles'; only the accelerations are fitted, :func:`fit_plan`) or a comma
+    list / sequence. The list always holds one axle's suspension displacement on both sides
+    (the segmentation's)."""
     resp = [c for c in available if c.split("_")[0] in ("susp", "axle", "body")]
+    acc = re.fullmatch(r"(axle\d+|axles)_acc", spec) if isinstance(spec, str) else None
+    if acc:
+        spec = acc.group(1)
     one = re.fullmatch(r"axle(\d+)", spec) if isinstance(spec, str) else None
     if spec is None:
         names = [c for c in axle_channels(reference_axle(resp)) if c in resp]
@@ -196,7 +229,9 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     chassis : str
     channels : str or sequence of str
         Fitted (and simulated) channels: 'axle3' (default; also for None), 'axles'
-        (:func:`axles_channels`), 'all' or names. The reported intervals take the
+        (:func:`axles_channels`), 'all', 'axle<N>_acc' / 'axles_acc' (those sets' axle
+        accelerations fitted, the segmentation's displacements only simulated) or names
+        (fitted as listed; :func:`fit_plan`). The reported intervals take the
         uncertainty calibration of the fit model and this channel set where there is one
         (``summary["fit"]["uncertainty_calibration"]`` says which, and whether it was
         calibrated for these channels).
@@ -275,7 +310,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         raise EroadInputError(f"--selection must be 'linear' or 'simulation', got {selection!r}")
 
     time = np.asarray(drive.time, float)
-    chans = {c: drive.channels[c].to_numpy(float) for c in fit_channels(drive.channel_names, channels)}
+    sim_names, fitted = fit_plan(drive.channel_names, channels)
+    chans = {c: drive.channels[c].to_numpy(float) for c in sim_names}
     speed = np.asarray(drive.speed, float)
     # the axle whose displacements segment the drive and place the segments on the road:
     # axle 3 where fitted, else the fitted pair (a logger on another axle)
@@ -286,10 +322,15 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     fs = 1.0 / float(np.median(np.diff(time)))
     noise_psd = noise_psd_from_sd(noise_sd, list(drive.channel_names), fs) if noise_sd else None
     from inverse.uncertainty import calibration_key
-    cset = channel_set(list(chans), drive.channel_names)
+    cset = channel_set(fitted, drive.channel_names)
     ckey, calibrated = calibration_key(fit_model, cset)
+    from inverse.features import FeatureSpec
+    # features of the fitted channels only where fewer than the simulated ones (the segmentation's
+    # displacements simulated, not fitted); otherwise the pipeline's default spec (every channel)
+    spec = None if set(fitted) == set(sim_names) else FeatureSpec(channels=tuple(sorted(fitted)))
     icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd,
-                           fit_model=fit_model, model_form=model_form, calibration=ckey, segment_on=segment_on)
+                           fit_model=fit_model, model_form=model_form, calibration=ckey, segment_on=segment_on,
+                           feature_spec=spec)
     make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans), ref_axle=ref)
     predict = TruckPredictRms(drive.vehicle, tuple(seg_disp), chassis=chassis, effects=effects)
 
@@ -422,7 +463,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                               "spread": sel["spread"],
                               "candidates": sel["candidates"],
                               "fit_phases_errors": headline(fit_rows)},
-                "fit": {**inv_summary["fit"], "channels": list(chans), "channel_set": cset, "reference_axle": ref,
+                "fit": {**inv_summary["fit"], "channels": list(fitted), "simulated_channels": list(chans),
+                        "channel_set": cset, "reference_axle": ref,
                         "uncertainty_calibration": ckey, "uncertainty_calibrated_for_channels": calibrated},
                 "segmentation": inv_summary["segmentation"],
                 "road": {"file": "road.npz", "crg": "road.crg", "seed": sel["seed"], "dx": SIM_DX,
@@ -452,7 +494,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                    "segments": segments if segments is not None else "auto",
                    "noise_sd": dict(noise_sd or {}), "polish": bool(polish),
                    "workers": workers, "seed": seed, "quick": quick, "candidates": n_cand, "max_iter": iters,
-                   "chassis": chassis, "channels": list(chans), "effects": json.dumps(effects or {}),
+                   "chassis": chassis, "channels": list(fitted), "simulated_channels": list(chans),
+                   "effects": json.dumps(effects or {}),
                    "fit_model": fit_model, "selection": selection, "model_form": model_form,
                    "channel_set": cset, "uncertainty_calibration": ckey,
                    "simulator": {"dx_m": SIM_DX, "nmax_cap_cpm": nmax_cap(SIM_DX)},

@@ -145,6 +145,17 @@ CALIBRATIONS["linear/axle1"] = CALIBRATIONS["linear"]
 # the friction drives, every quantity wide on the independent truck), no new failure.
 CALIBRATIONS["linear/axle2"] = CALIBRATIONS["linear"]
 CALIBRATIONS["linear/axle4"] = CALIBRATIONS["linear"]
+# The linear fit of axle 3's two axle accelerations alone ('axle3_acc': the displacements segment
+# the drive, their features are not fitted), 2026-11-28: R_REF and KAPPA on 60 null drives (seeds
+# 1-60), BETA by the --beta-from rule on the 20 friction drives fitted the same way; out of sample
+# they cover 94 / 91 / 88 % and 92 / 90 / 89 % of null seeds 61-100 and 101-140, 95 / 95 / 98 % of
+# the independent truck's 20 drives, 94 / 98 / 98 % of the friction drives (ln Gq(n0) / w /
+# ln G(n_best); results/inverse_blind/20261128-acceleration-only-fit/). BETA_DIAGNOSED is the
+# axle-3 fit's, NOT calibrated for these channels (no closed-loop set was fitted on them).
+CALIBRATIONS["linear/axle3_acc"] = {"R_REF": 0.583, "R_GATE": 2.92,
+                                    "KAPPA": {"ln_Gq_n0": 1.64, "w": 1.95, "ln_G_n_best": 2.31},
+                                    "BETA": {"ln_Gq_n0": 0.3, "w": 0.01, "ln_G_n_best": 0.1},
+                                    "BETA_DIAGNOSED": dict(CALIBRATIONS["linear"]["BETA_DIAGNOSED"])}
 
 
 def calibration(fit_model: str = "simulation") -> dict:

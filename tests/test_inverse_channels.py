@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from eroad.errors import EroadInputError
-from inverse.run import CHANNEL_SETS, axles_channels, channel_set, fit_channels, reference_axle
+from inverse.run import CHANNEL_SETS, axles_channels, channel_set, fit_channels, fit_plan, reference_axle
 
 TRUCK = ([f"susp_disp_{a}{s}" for a in range(1, 5) for s in "LR"]
          + [f"axle_acc_{a}{s}" for a in range(1, 5) for s in "LR"]
@@ -21,7 +21,37 @@ def test_axles_is_axle3_suspension_and_every_axle_acceleration():
 
 @pytest.mark.parametrize("spec", CHANNEL_SETS)
 def test_a_named_set_is_named_back(spec):
-    assert channel_set(fit_channels(TRUCK, spec), TRUCK) == spec
+    assert channel_set(fit_plan(TRUCK, spec)[1], TRUCK) == spec
+
+
+def test_acceleration_sets_simulate_the_displacements_and_fit_the_accelerations():
+    """'axle3_acc' / 'axles_acc': the simulated channels are those of 'axle3' / 'axles' (the
+    segmentation needs axle 3's displacements), the fitted ones the axle accelerations alone; a
+    comma list is fitted as listed, the displacement pair added for the segmentation is not."""
+    for acc, base in (("axle3_acc", "axle3"), ("axles_acc", "axles")):
+        sim, fitted = fit_plan(TRUCK, acc)
+        assert sim == fit_channels(TRUCK, base) == fit_channels(TRUCK, acc)
+        assert fitted == [c for c in sim if c.startswith("axle_acc_")] and len(fitted) == (2 if acc == "axle3_acc" else 8)
+    sim, fitted = fit_plan(TRUCK, "axle_acc_3L,axle_acc_3R")
+    assert sim[:2] == ["susp_disp_3L", "susp_disp_3R"] and fitted == ["axle_acc_3L", "axle_acc_3R"]
+    assert channel_set(fitted, TRUCK) == "axle3_acc"
+    for spec in (None, "axle3", "axles", "all", "susp_disp_3L,susp_disp_3R,axle_acc_3L,axle_acc_3R"):
+        sim, fitted = fit_plan(TRUCK, spec)
+        assert fitted == sim
+    with pytest.raises(EroadInputError, match="no axle acceleration"):
+        fit_plan(["susp_disp_3L", "susp_disp_3R", "speed"], "axle3_acc")
+
+
+def test_the_acceleration_fit_has_its_own_calibration():
+    """'axle3_acc' carries constants set on its own blind fits (inverse.uncertainty); 'axles_acc'
+    falls back to the axle-3 ones and says it was not checked."""
+    from inverse.report import channels_note
+    from inverse.uncertainty import calibration_key
+
+    assert calibration_key("linear", "axle3_acc") == ("linear/axle3_acc", True)
+    assert calibration_key("linear", "axles_acc") == ("linear", False)
+    note = channels_note("axle3_acc", True)
+    assert "axle acceleration of axle 3" in note and "only segment" in note
 
 
 def test_other_lists_are_custom_and_default_is_axle3():

@@ -231,3 +231,27 @@ def test_segment_on_option_reaches_the_segmentation(short_drive, tmp_path):
     s = json.loads((out / "summary.json").read_text())
     assert s["segmentation"]["boundaries_from"].startswith("axle_acc_3L, axle_acc_3R in 6-12")
     assert len(s["segments"]) == 2
+
+
+def test_acceleration_only_fit_simulates_the_displacements_but_does_not_fit_them(short_drive, tmp_path):
+    """``eroad invert --channels axle3_acc``: the fit compares the axle accelerations alone
+    (summary fit.channels and config.toml), the displacements are still simulated (they segment
+    the drive and fill Table 2), the features are fewer than the default fit's on the same
+    segments (the displacements' bands are gone), and the intervals name their own calibration;
+    smoke-size: K = 2, one iteration, serial."""
+    ds, _, _ = short_drive
+    runs = {}
+    for name, extra in (("default", []), ("acc", ["--channels", "axle3_acc"])):
+        out = tmp_path / name
+        assert main(["invert", str(ds), "--out", str(out), "--segments", "2", "--workers", "1",
+                     "--max-iter", "1", "--candidates", "0", "--quiet"] + extra) == 0
+        runs[name] = json.loads((out / "summary.json").read_text())
+    fit = runs["acc"]["fit"]
+    assert fit["channels"] == ["axle_acc_3L", "axle_acc_3R"]
+    assert {"susp_disp_3L", "susp_disp_3R"} <= set(fit["simulated_channels"])
+    assert fit["channel_set"] == "axle3_acc" and fit["uncertainty_calibration"] == "linear/axle3_acc"
+    assert {"susp_disp_3L", "susp_disp_3R"} <= {r["channel"] for r in runs["acc"]["table2"]}
+    assert 0 < fit["n_features"] < runs["default"]["fit"]["n_features"]
+    import tomllib
+    cfg = tomllib.loads((tmp_path / "acc" / "config.toml").read_text())
+    assert cfg["channels"] == ["axle_acc_3L", "axle_acc_3R"]
