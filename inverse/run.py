@@ -77,6 +77,8 @@ AXLE3_CHANNELS = axle_channels(PREFERRED_AXLE)
 #: the named channel sets of ``--channels`` besides a comma list ('axle<N>' names any axle;
 #: 'axle<N>_acc' and 'axles_acc' fit the axle accelerations of those sets alone)
 CHANNEL_SETS = ("axle3", "axles", "all", "axle3_acc", "axles_acc")
+#: an acceleration set's name: the set whose axle accelerations alone are fitted
+_ACC_SET = re.compile(r"(axle\d+|axles)_acc")
 
 
 def paired_axles(names) -> list:
@@ -139,15 +141,14 @@ def fit_plan(available, spec) -> tuple[list, list]:
     axle accelerations of 'axle<N>' or 'axles' alone) and a comma list, whose channels are
     fitted as listed: a displacement pair added for the segmentation is simulated, not fitted.
     """
-    acc = re.fullmatch(r"(axle\d+|axles)_acc", spec) if isinstance(spec, str) else None
+    sim = fit_channels(available, spec)
+    acc = _ACC_SET.fullmatch(spec) if isinstance(spec, str) else None
     if acc:
-        sim = fit_channels(available, acc.group(1))
         fitted = [c for c in sim if c.startswith("axle_acc_")]
         if not fitted:
             raise EroadInputError(f"--channels {spec}: the drive logs no axle acceleration of "
                                   f"{'that axle' if acc.group(1) != 'axles' else 'any axle'}")
         return sim, fitted
-    sim = fit_channels(available, spec)
     if isinstance(spec, str) and (spec in CHANNEL_SETS or re.fullmatch(r"axle\d+", spec)) or spec is None:
         return sim, list(sim)
     listed = [c.strip() for c in (spec.split(",") if isinstance(spec, str) else spec) if c.strip()]
@@ -162,7 +163,7 @@ def fit_channels(available, spec) -> list:
     list / sequence. The list always holds one axle's suspension displacement on both sides
     (the segmentation's)."""
     resp = [c for c in available if c.split("_")[0] in ("susp", "axle", "body")]
-    acc = re.fullmatch(r"(axle\d+|axles)_acc", spec) if isinstance(spec, str) else None
+    acc = _ACC_SET.fullmatch(spec) if isinstance(spec, str) else None
     if acc:
         spec = acc.group(1)
     one = re.fullmatch(r"axle(\d+)", spec) if isinstance(spec, str) else None
