@@ -326,9 +326,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     cset = channel_set(fitted, drive.channel_names)
     ckey, calibrated = calibration_key(fit_model, cset)
     from inverse.features import FeatureSpec
-    # features of the fitted channels only where fewer than the simulated ones (the segmentation's
-    # displacements simulated, not fitted); otherwise the pipeline's default spec (every channel)
-    spec = None if set(fitted) == set(sim_names) else FeatureSpec(channels=tuple(sorted(fitted)))
+    # the features of the fitted channels (the segmentation's displacements may be simulated only)
+    spec = FeatureSpec(channels=tuple(sorted(fitted)))
     icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd,
                            fit_model=fit_model, model_form=model_form, calibration=ckey, segment_on=segment_on,
                            feature_spec=spec)
