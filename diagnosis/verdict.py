@@ -49,8 +49,9 @@ Vocabulary
        tested on its own road-independent signature instead of the transmissibility it barely
        moves (:func:`own_signature_agrees`: the stroke-velocity L-skewness), both ways.  ``identified``
     (in the result) is True when the named effect's identity and value are not in doubt
-    (no close rival, no range edge) even if a remainder keeps it from "clear": the
-    closed loop (``diagnosis.closed_loop``) corrects with such an effect.  The front-to-rear delay and the amplitude distribution
+    (no close rival, no range edge) even if a remainder keeps it from "clear"; the closed
+    loop (``diagnosis.closed_loop``) corrects with every named effect whose value is not at a
+    range edge, whatever its confidence, and says which of these it was.  The front-to-rear delay and the amplitude distribution
        (skewness) are terms of every gap the ranking scores, so 1. already asks them.
 
     ``confidence`` is ``clear`` when no rival sharing no effect comes within the
@@ -94,7 +95,7 @@ SIGNATURE_CHI2_MAX = 2.0
 SIGNATURE_SHARE_MIN = 0.15
 #: least improvement of a named effect over the nominal model, in sd of its paired noise
 #: (``improvement / null_improvement_sd`` of its ranking entry), for confidence "clear" and for
-#: ``identified`` (what the closed loop corrects with).  The ranking accepts against the paired
+#: ``identified``.  The ranking accepts against the paired
 #: null's mean, which is negative where calibrations fit noise, so an effect can be accepted
 #: while improving on the nominal model by less than 2 sd.  Set after a blind failure: on 20
 #: independent-truck drives without a library effect, leaf friction 337 N was named "clear" at
@@ -102,7 +103,7 @@ SIGNATURE_SHARE_MIN = 0.15
 #: friction 593 N at 1.7 sd) and no other (docs/diagnosis.md)
 CLEAR_Z_MIN = 3.0
 #: A winner whose signature disagrees is still NAMED (confidence "ambiguous", never
-#: ``identified``, so the closed loop does not correct with it) when it takes the whole gap:
+#: ``identified``) when it takes the whole gap:
 #: it explains at least FULL_SHARE_MIN of the held-out gap above a correct model's AND its
 #: held-out gap is within FULL_GAP_Z sd of a correct model's (``residual``), with the ranking's
 #: own verdict clear (no close rival) and a gap beyond noise. Without it, an effect that acts
@@ -624,7 +625,7 @@ def decide(summary: Mapping, *, tie_break: bool = SIGNATURE_TIE_BREAK, **kw) -> 
                 reason=(f"{d2['reason']}; {rd['verdict']} fits the held-out gap as well (within "
                         f"noise), but {R['effect']}'s {what} axle-to-body transmissibility is "
                         f"nearer the measurement (mean z^2 {dr:.2g} against {dw:.2g}), so "
-                        f"{R['effect']} is named -- not 'clear', no correction"))
+                        f"{R['effect']} is named -- not 'clear'"))
 
 
 @dataclass
@@ -836,13 +837,13 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     if edge_named:
         caveats.append(f"; it calibrates at the edge of its search range ({', '.join(edges)}) in "
                        f"{'a fold' if len(win.get('parameters_per_fold') or []) > 1 else 'the fit'}: "
-                       f"named on its own signature, the value is a bound -- not 'clear', no correction")
+                       f"named on its own signature, the value is a bound -- not 'clear', no correction (a bound is not an estimate)")
     if on_signature:
         caveats.append(
             f"; named on its {what}: it removes {sig_frac:.0%} of the nominal model's excess "
             f"there (mean z^2 {c0:.2g} -> {c1:.2g}) though it explains only {share:.0%} of the "
             f"held-out gap above a correct model's ({share_min:.0%} asked otherwise): a larger "
-            f"difference no library effect lists remains beside it -- not 'clear', no correction")
+            f"difference no library effect lists remains beside it -- not 'clear'")
     if on_gap_alone:
         caveats.append(
             f"; named on the gap alone: with it the held-out gap ({res['heldout_gap']:.3g}) is "
@@ -850,7 +851,7 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"but its {what} stays off (mean z^2 {c1:.2g}, nominal {c0:.2g}, at most "
             f"{sig_max:.2g} asked): the effect does not bring it nearer, so the "
             f"signature cannot confirm it, and what keeps the transmissibility off (a difference "
-            f"beyond it, or this drive's noise) is not known -- not 'clear', no correction")
+            f"beyond it, or this drive's noise) is not known -- not 'clear'")
     if st.corroborated:
         s2 = summary["signature_two_input"]
         caveats.append(
@@ -858,7 +859,7 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"threshold ({signature_max:.2g}) but within what the model reaches against "
             f"itself on other road phases (up to {sig_max:.2g}), and its two-input "
             f"transmissibility agrees (mean z^2 {s2['chi2_nominal']:.2g} -> "
-            f"{s2['chi2_model']:.2g}): corroborated, not 'clear', no correction")
+            f"{s2['chi2_model']:.2g}): corroborated, not 'clear'")
     z_abs = improvement_z(win)
     weak = z_abs is not None and z_abs < CLEAR_Z_MIN
     if weak:

@@ -15,17 +15,24 @@ CLEAR = {"verdict": "leaf_friction", "verdict_confidence": "clear",
 
 @pytest.mark.parametrize("summary, expect", [
     (CLEAR, {"leaf_friction": {"force": 2200.0}}),
-    ({**CLEAR, "verdict_confidence": "ambiguous"}, None),
+    ({**CLEAR, "verdict_confidence": "ambiguous"}, {"leaf_friction": {"force": 2200.0}}),
+    ({**CLEAR, "verdict_confidence": "ambiguous", "verdict_detail": {"edge": ["leaf_friction.force"]}}, None),
     ({**CLEAR, "verdict": "none", "verdict_confidence": "none"}, None),
     ({**CLEAR, "verdict": "unexplained", "verdict_confidence": "clear"}, None),
     ({**CLEAR, "ranking": []}, None),
 ])
-def test_only_a_clear_named_effect_is_used(summary, expect):
-    """The verdict's own ranking entry gives the parameters (not the first entry); anything
-    short of a clear effect keeps the nominal model, with the reason in one line."""
+def test_a_named_effect_is_used_unless_its_value_is_a_bound(summary, expect):
+    """The verdict's own ranking entry gives the parameters (not the first entry); a named
+    effect is used whatever its confidence (the reason says which), except where it
+    calibrates at its search range's edge; none, unexplained and a name without parameters
+    keep the nominal model, with the reason in one line."""
     effects, reason = effects_from_diagnosis(summary)
     assert effects == expect
     assert "\n" not in reason and (("inverted with leaf_friction.force=2200" in reason) == bool(expect))
+    if expect and summary["verdict_confidence"] == "ambiguous":
+        assert "confidence 'ambiguous'" in reason
+    if (summary.get("verdict_detail") or {}).get("edge"):
+        assert "edge of its search range (leaf_friction.force)" in reason
 
 
 def test_run_folder_with_a_given_diagnosis(tmp_path):

@@ -185,7 +185,7 @@ def test_whole_gap_is_named_on_the_gap_alone_never_clear():
     """An effect that takes the whole gap (share >= FULL_SHARE_MIN, the gap left within
     FULL_GAP_Z sd of a correct model's) is named although its transmissibility stays off as
     the nominal model's (an effect acting on axle and body alike cannot move it): confidence
-    'ambiguous', not identified (no correction), and the reason says so. A gap left beyond a
+    'ambiguous', not identified, and the reason says so (the closed loop still corrects with it). A gap left beyond a
     correct model's, a share below FULL_SHARE_MIN, a ranking with a close rival, or no gap
     beyond noise keep 'unexplained'."""
     from diagnosis.verdict import FULL_GAP_Z, FULL_SHARE_MIN
@@ -194,12 +194,13 @@ def test_whole_gap_is_named_on_the_gap_alone_never_clear():
     d = decide(_summary(after=0.45, chi2=off))     # share 0.92, gap left 1 sd above a correct model's
     assert d["verdict"] == "leaf_friction" and d["confidence"] == "ambiguous"
     assert d["identified"] is False and d["signature_agrees"] is False
-    assert "gap alone" in d["reason"] and "no correction" in d["reason"]
+    assert "gap alone" in d["reason"] and "not 'clear'" in d["reason"]
     # the reason does not also say the transmissibility agrees (it read "agrees ... stays off")
     assert "agrees with the measurement" not in d["reason"]
     from diagnosis.closed_loop import effects_from_diagnosis
     assert effects_from_diagnosis({**_summary(after=0.45, chi2=off), "verdict": d["verdict"],
-                                   "verdict_confidence": d["confidence"], "verdict_detail": d})[0] is None
+                                   "verdict_confidence": d["confidence"], "verdict_detail": d})[0] == {
+        "leaf_friction": {"force": 4000.0}}
     after_z = 0.4 + (FULL_GAP_Z + 0.5) * 0.05           # gap left 2.5 sd above
     assert decide(_summary(after=after_z, chi2=off))["verdict"] == "unexplained"
     # share just below FULL_SHARE_MIN with a wide correct-model scatter (so only the share fails)
