@@ -399,7 +399,8 @@ def score_run(ds: Path, scen: str, summ: dict) -> dict:
     case["fit_model"] = summ.get("fit", {}).get("model")
     loop = summ.get("closed_loop")
     if loop is not None:
-        case["closed_loop"] = {k: loop.get(k) for k in ("verdict", "confidence", "effects", "corrected")}
+        case["closed_loop"] = {k: loop.get(k) for k in ("verdict", "confidence", "effects", "corrected",
+                                                         "model_form")}
         if loop.get("corrected") and scen != "second_measured":
             case["nominal"] = score_case(truth, {"segments": loop["nominal_segments"]})["segments"]
     return case

@@ -62,10 +62,11 @@ def profile_rows(case: dict, min_s: float = 3.0) -> list:
 
 def redecided_loops(diag_root: Path) -> dict:
     """Per seed, the closed loop as today's verdict rules would run it: ``{seed: (verdict,
-    corrected)}`` from the saved diagnoses of a blind folder (``blind.json`` and
+    corrected, singled out)}`` from the saved diagnoses of a blind folder (``blind.json`` and
     ``caseNNN-summary.json``, re-decided by ``diagnosis.verdict.decide``; corrected as
-    ``diagnosis.closed_loop.effects_from_diagnosis`` decides)."""
-    from diagnosis.closed_loop import effects_from_diagnosis
+    ``diagnosis.closed_loop.effects_from_diagnosis`` decides, singled out as
+    ``diagnosis.closed_loop.singled_out``)."""
+    from diagnosis.closed_loop import effects_from_diagnosis, singled_out
     from diagnosis.verdict import decide
 
     out = {}
@@ -73,7 +74,7 @@ def redecided_loops(diag_root: Path) -> dict:
         summ = json.loads((diag_root / f"case{r['case']:03d}-summary.json").read_text())
         d = decide(summ)
         summ = dict(summ, verdict=d["verdict"], verdict_confidence=d["confidence"], verdict_detail=d)
-        out[int(r["seed"])] = (d["verdict"], effects_from_diagnosis(summ)[0] is not None)
+        out[int(r["seed"])] = (d["verdict"], effects_from_diagnosis(summ)[0] is not None, singled_out(summ))
     return out
 
 
@@ -86,7 +87,8 @@ def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool 
 
     Each row gets ``model_form`` (``inverse.uncertainty.MODEL_FORMS``) as
     ``diagnosis.closed_loop.model_form`` decides it from the record's ``closed_loop``
-    (records without one: "open"). ``loops`` (``{seed: (verdict, corrected)}``,
+    (records without one: "open"), or the record's own ``closed_loop.model_form`` where it holds
+    one (records made after 2026-11-28: a correction with an 'ambiguous' name is "open"). ``loops`` (``{seed: (verdict, corrected)}``,
     :func:`redecided_loops`) replaces the recorded verdicts: a drive corrected then and not
     now is scored on its nominal rows (with ``profile``, left out: the records keep the
     profile rows of the corrected inversion only)."""
@@ -100,13 +102,14 @@ def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool 
         loop = case.get("closed_loop")
         nominal_rows = open_loop and bool(case.get("nominal"))
         if loop and loops is not None and case["seed"] in loops:
-            verdict, corrected = loops[case["seed"]]
+            verdict, corrected, singled = (tuple(loops[case["seed"]]) + (True,))[:3]
             if corrected and not loop.get("corrected"):
                 raise SystemExit(f"{root}: seed {case['seed']} would be corrected now and has no corrected record")
             nominal_rows = nominal_rows or (loop.get("corrected") and not corrected)
-            loop = {"verdict": verdict, "corrected": corrected}
+            loop = {"verdict": verdict, "corrected": corrected,
+                    "model_form": model_form(verdict, corrected, singled)}
         form = "open" if not loop or (nominal_rows and loop.get("corrected")) else \
-            model_form(loop.get("verdict"), bool(loop.get("corrected")))
+            loop.get("model_form") or model_form(loop.get("verdict"), bool(loop.get("corrected")))
         if profile:
             was_corrected = bool((case.get("closed_loop") or {}).get("corrected"))
             segs = [] if nominal_rows and was_corrected else profile_rows(case, min_s)

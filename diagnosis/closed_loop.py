@@ -119,15 +119,27 @@ def loop_channels(verdict: str | None, channels=None, available=None) -> tuple:
     return None, ""
 
 
-def model_form(verdict: str | None, corrected: bool) -> str:
+def singled_out(summary: dict) -> bool:
+    """Whether the diagnosis singled its named effect out: confidence ``clear``, or
+    ``identified`` (a remainder beside an undisputed effect)."""
+    return (summary.get("verdict_confidence") == "clear"
+            or bool((summary.get("verdict_detail") or {}).get("identified")))
+
+
+def model_form(verdict: str | None, corrected: bool, singled: bool = True) -> str:
     """The model-form state of a closed loop's reported inversion
     (:data:`inverse.uncertainty.MODEL_FORMS`): "diagnosed" where the diagnosis found no gap
-    beyond noise (``none``) or named an effect the inversion then carries (``corrected``);
-    "open" where a vehicle difference is left unaccounted for: a gap no library effect
-    explains (``unexplained``; on the measured road profile the smaller term covered
-    ln G(n_best) in 6 of 10 fitted segments, docs/inverse.md section 11) or an effect named at
-    an edge of its search range (not carried, :func:`effects_from_diagnosis`)."""
-    return "diagnosed" if corrected or verdict == "none" else "open"
+    beyond noise (``none``) or named an effect it singled out (``singled``,
+    :func:`singled_out`) that the inversion then carries (``corrected``); "open" where a
+    vehicle difference may be left unaccounted for: a gap no library effect explains
+    (``unexplained``; on the measured road profile the smaller term covered ln G(n_best) in 6
+    of 10 fitted segments, docs/inverse.md section 11), an effect named at an edge of its
+    search range (not carried, :func:`effects_from_diagnosis`), or a correction with a name
+    short of that (``ambiguous``: the nearest library effect, which may leave part of the
+    difference in the road -- on 20 fresh friction drives with a flexible frame the smaller
+    term covered ln G(n_best) in 82 % of the segments, the open one on those corrections in
+    86 %; results/inverse_blind/20261128-correct-on-ambiguous/)."""
+    return "diagnosed" if verdict == "none" or (corrected and singled) else "open"
 
 
 def _start(out, force: bool) -> tuple[Path, Path]:
@@ -235,7 +247,8 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
         if effects:
             progress("closed loop: corrected inversion ...")
             chosen = run_inversion(dataset, work / "corrected", workers=workers, seed=seed, quick=quick,
-                                   effects=effects, argv=argv, model_form=model_form(dsum.get("verdict"), True),
+                                   effects=effects, argv=argv,
+                                   model_form=model_form(dsum.get("verdict"), True, singled_out(dsum)),
                                    **inversion)
             main = work / "corrected"
             (work / "nominal").rename(main / "nominal")

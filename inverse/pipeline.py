@@ -80,7 +80,8 @@ class InversionConfig:
     model_form : {"open", "diagnosed"}
         Which model-form term the reported uncertainty carries
         (:data:`inverse.uncertainty.MODEL_FORMS`): "diagnosed" where the diagnosis found no
-        gap on this drive or named the effect the fit carries (``diagnosis.closed_loop``).
+        gap on this drive or named and singled out the effect the fit carries
+        (``diagnosis.closed_loop.model_form``).
     calibration : str, optional
         Key of the uncertainty calibration (:data:`inverse.uncertainty.CALIBRATIONS`,
         :func:`inverse.uncertainty.calibration_key`: fit model and channel set); None: the

@@ -85,11 +85,12 @@ ROAD_MODEL_NOTE = (
 #: the sentence of Table 1's note per model-form state (:data:`inverse.uncertainty.MODEL_FORMS`)
 MODEL_FORM_NOTE = {
     "open": ("Model-form term: 'open' -- a vehicle difference may be unaccounted for (the model was not "
-             "checked against this drive, or the diagnosis found a gap no library effect explains), so "
+             "checked against this drive, the diagnosis found a gap no library effect explains, or the "
+             "effect this fit carries is the nearest one the diagnosis named without singling it out), so "
              "the intervals allow for it hiding in the road level (`eroad invert --effects auto` "
              "diagnoses first)."),
-    "diagnosed": ("Model-form term: 'diagnosed' -- the diagnosis found no gap beyond noise, or named the "
-                  "effect this fit carries, so the intervals carry the smaller term calibrated on "
+    "diagnosed": ("Model-form term: 'diagnosed' -- the diagnosis found no gap beyond noise, or named and "
+                  "singled out the effect this fit carries, so the intervals carry the smaller term calibrated on "
                   "diagnosed drives."),
 }
 

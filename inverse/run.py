@@ -265,8 +265,9 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         iteration and per candidate realisation.
     model_form : {"open", "diagnosed"}
         The model-form term of the reported intervals (:data:`inverse.uncertainty.MODEL_FORMS`):
-        "open" unless the diagnosis found no gap on this drive or named the effect this fit
-        carries (``diagnosis.closed_loop`` sets it); recorded in ``summary["fit"]["model_form"]``.
+        "open" unless the diagnosis found no gap on this drive or named and singled out the effect
+        this fit carries (``diagnosis.closed_loop.model_form`` sets it); recorded in
+        ``summary["fit"]["model_form"]``.
     segment_on : {"displacement", "axle_acc"}
         What the segment boundaries are located on (:class:`inverse.pipeline.InversionConfig`):
         the reference axle's suspension displacements in 3-20 Hz (default) or the octave bands

@@ -85,10 +85,12 @@ Z90 = 1.6448536269514722
 # The model-form term depends on what is known of the vehicle (``MODEL_FORMS``). "open": a
 # vehicle difference may be unaccounted for -- the model was not checked against this drive
 # (``eroad invert`` without ``--effects auto``), or the diagnosis found a gap it could not
-# put on one library effect (``unexplained``, or a name it could not single out): BETA is the
+# put on one library effect (``unexplained``, or a name it could not single out, whether or
+# not the inversion then carries it -- since 2026-11-28 the closed loop corrects with such
+# 'ambiguous' names too, and keeps this term for them): BETA is the
 # one set on the friction drives inverted with the nominal model. "diagnosed": the diagnosis
-# ran on this drive and found no gap beyond noise (``none``) or named an effect that the
-# inversion then carried (corrected): what is left costs misfit but little level bias, so
+# ran on this drive and found no gap beyond noise (``none``) or named and singled out (clear, or
+# identified) an effect that the inversion then carried: what is left costs misfit but little level bias, so
 # BETA_DIAGNOSED is smaller. Set (2026-11-24) by the rule of
 # ``benchmarks/calibrate_uncertainty.py --beta-diagnosed-from``: per quantity the smallest
 # grid value at which 90 % of the diagnosed segments' intervals hold, on the two closed-loop

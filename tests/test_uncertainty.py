@@ -115,14 +115,18 @@ def test_a_diagnosed_drive_carries_the_smaller_model_form_term():
     assert "'open'" in table1_note({"status": "clean"}, model_form="open")
 
 
-@pytest.mark.parametrize("verdict, corrected, form", [
-    ("none", False, "diagnosed"), ("leaf_friction", True, "diagnosed"),
-    ("unexplained", False, "open"), ("leaf_friction", False, "open")])
-def test_closed_loop_model_form(verdict, corrected, form):
-    """Only a drive the diagnosis found no gap in, or one inverted with the effect it named,
-    gets the smaller term; an unexplained gap or a name not acted on keeps the open one."""
-    from diagnosis.closed_loop import model_form
-    assert model_form(verdict, corrected) == form
+@pytest.mark.parametrize("verdict, corrected, singled, form", [
+    ("none", False, True, "diagnosed"), ("leaf_friction", True, True, "diagnosed"),
+    ("leaf_friction", True, False, "open"),
+    ("unexplained", False, True, "open"), ("leaf_friction", False, True, "open")])
+def test_closed_loop_model_form(verdict, corrected, singled, form):
+    """Only a drive the diagnosis found no gap in, or one inverted with an effect it named and
+    singled out (clear or identified), gets the smaller term; an unexplained gap, a name not
+    acted on, or a correction with an 'ambiguous' name keeps the open one."""
+    from diagnosis.closed_loop import model_form, singled_out
+    assert model_form(verdict, corrected, singled) == form
+    assert singled_out({"verdict_confidence": "clear"}) and not singled_out({"verdict_confidence": "ambiguous"})
+    assert singled_out({"verdict_confidence": "ambiguous", "verdict_detail": {"identified": True}})
 
 
 def test_beta_diagnosed_rule_picks_the_smallest_value_that_covers_90_percent():
