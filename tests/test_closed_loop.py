@@ -35,23 +35,26 @@ def test_a_named_effect_is_used_unless_its_value_is_a_bound(summary, expect):
         assert "edge of its search range (leaf_friction.force)" in reason
 
 
-def test_run_folder_with_a_given_diagnosis(tmp_path):
+@pytest.mark.parametrize("confidence, form", [("clear", "diagnosed"), ("ambiguous", "open")])
+def test_run_folder_with_a_given_diagnosis(tmp_path, confidence, form):
     """With a diagnosis that names leaf friction (given, so the test exercises the loop and not
     the diagnosis): RUN holds the corrected inversion, nominal/ and diagnose/ beside it, the
     side-by-side table, and summary.json's closed_loop; the corrected fit ran with the effect
-    (config.toml) and differs from the nominal one."""
+    (config.toml) and differs from the nominal one. A 'clear' name gives the corrected fit the
+    smaller model-form term, an 'ambiguous' one (corrected too) keeps the open term."""
     from drives.synth import synth_command
 
     ds = tmp_path / "ds"
     synth_command(scenario="random", seed=5, duration=8.0, out=ds)
     diag = tmp_path / "diag"
     diag.mkdir()
-    (diag / "summary.json").write_text(json.dumps(CLEAR))
+    (diag / "summary.json").write_text(json.dumps({**CLEAR, "verdict_confidence": confidence}))
     (diag / "report.md").write_text("# given\n")
     run = tmp_path / "run"
     s = invert_closed_loop(ds, run, workers=1, seed=0, diagnosis=diag, progress=lambda m: None,
                            segments=1, max_iter=2, candidates=1)
     assert s["closed_loop"]["corrected"] and s["closed_loop"]["effects"] == {"leaf_friction": {"force": 2200.0}}
+    assert s["closed_loop"]["model_form"] == form and s["fit"]["model_form"] == form
     for f in ("summary.json", "config.toml", "road.npz", "nominal/summary.json", "diagnose/report.md",
               "tables/table1_nominal_vs_corrected.md", "tables/table1.md"):
         assert (run / f).is_file(), f
