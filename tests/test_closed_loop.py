@@ -117,6 +117,9 @@ def test_an_unexplained_verdict_fits_axle_3_accelerations_only_where_axle_3_is_t
     assert calibration_key("linear", "axle3_acc") == ("linear/axle3_acc", True)
     front = ["susp_disp_1L", "susp_disp_1R", "axle_acc_1L", "axle_acc_1R", "speed"]
     assert loop_channels("unexplained", None, front) == (None, "")
+    # displacements of axle 1 only (the reference) but every axle's accelerations: not axle 3's set
+    front_acc = ["susp_disp_1L", "susp_disp_1R"] + [f"axle_acc_{a}{s}" for a in range(1, 5) for s in "LR"]
+    assert loop_channels("unexplained", None, front_acc) == (None, "")
     no_acc3 = [c for c in truck if c not in ("axle_acc_3L", "axle_acc_3R")]
     assert loop_channels("unexplained", None, no_acc3) == (None, "")
 
