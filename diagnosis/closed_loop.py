@@ -95,19 +95,43 @@ def effects_from_diagnosis(summary: dict, action: str = "inverted") -> tuple[dic
 #: (friction drives, loop closed: 63 % against 80 %), so every other verdict keeps axle 3.
 #: results/inverse_blind/20261124-channels-all-axles/ and .../20261124-axles-when-none/
 CHANNELS_WHEN_NONE = "axles"
+#: the channels the closed loop fits where the diagnosis answers ``unexplained`` and the caller
+#: chose none: axle 3's axle accelerations alone (its suspension displacements still segment the
+#: drive). A gap no library effect explains is a vehicle the model does not describe; the
+#: displacements carry the body's motion at 0.5-3 Hz, where such a difference shows most, while
+#: the axle accelerations are dominated by the tyre and the road around the wheel hop. Measured
+#: (2026-11-28, results/inverse_blind/20261128-correct-on-ambiguous/): on the independently
+#: written truck (20 drives, closed loop, 14 'unexplained') G(1 cycle/m) within 20 % 75.9 ->
+#: 81.0 % of 58 segments (paired 5 / 2), class 82.8 -> 86.2 %; on its measured-road drives 2 -> 5
+#: of 12 fitted segments against the profile; on the friction drives the one 'unexplained' drive
+#: lost 2 segments by 0.01 in ln G. Only where axle 3 is the drive's reference axle (the set with
+#: its own interval constants, inverse.uncertainty.CALIBRATIONS["linear/axle3_acc"]).
+CHANNELS_WHEN_UNEXPLAINED = "axle3_acc"
 
 
 def loop_channels(verdict: str | None, channels=None, available=None) -> tuple:
     """The fitted channels of a closed loop's inversions and the phrase that says why.
 
     ``channels`` given by the caller are kept (the phrase is empty); None: ``axles``
-    (:data:`CHANNELS_WHEN_NONE`) where the verdict is ``none``, else None: the inversion's
-    default, axle 3 (or the reference axle of a drive logged elsewhere, ``inverse.run.reference_axle``).
+    (:data:`CHANNELS_WHEN_NONE`) where the verdict is ``none``, ``axle3_acc``
+    (:data:`CHANNELS_WHEN_UNEXPLAINED`) where it is ``unexplained`` and axle 3 is the drive's
+    reference axle with both axle accelerations logged, else None: the inversion's default,
+    axle 3 (or the reference axle of a drive logged elsewhere, ``inverse.run.reference_axle``).
     ``available`` (the drive's channel names): where ``axles`` holds no more than the default
-    (a drive logged on one axle), the default is kept and the phrase says so.
+    (a drive logged on one axle), the default is kept and the phrase says so. Without
+    ``available`` the drive is taken to log axle 3.
     """
     if channels is not None:
         return channels, ""
+    if verdict == "unexplained":
+        if available is not None:
+            from inverse.run import PREFERRED_AXLE, reference_axle
+            if (reference_axle(available) != PREFERRED_AXLE
+                    or not {"axle_acc_3L", "axle_acc_3R"} <= set(available)):
+                return None, ""
+        return CHANNELS_WHEN_UNEXPLAINED, ("a gap no library effect explains, so axle 3's axle accelerations "
+                                           "alone are fitted (channel set 'axle3_acc'; the suspension "
+                                           "displacements, where the body's motion shows, only segment the drive)")
     if verdict == "none":
         if available is not None:
             from inverse.run import fit_channels

@@ -87,7 +87,7 @@ def test_a_corrected_fit_that_stays_poor_says_what_is_left():
 
 @pytest.mark.parametrize("verdict, given, expect", [
     ("none", None, "axles"),
-    ("unexplained", None, None),
+    ("unexplained", None, "axle3_acc"),
     ("leaf_friction", None, None),
     (None, None, None),
     ("none", "axle3", "axle3"),
@@ -95,13 +95,36 @@ def test_a_corrected_fit_that_stays_poor_says_what_is_left():
 ])
 def test_channels_follow_the_verdict_unless_given(verdict, given, expect):
     """Every axle's accelerations only where the diagnosis found no gap; a vehicle difference
-    left in the model would reach more channels (friction drives: G(1) 80 % -> 63 %); a
-    caller's choice is kept and then no reason is added."""
+    left in the model would reach more channels (friction drives: G(1) 80 % -> 63 %); where the
+    gap is unexplained, axle 3's accelerations alone; a caller's choice is kept and then no
+    reason is added."""
     from diagnosis.closed_loop import loop_channels
 
     chans, why = loop_channels(verdict, given)
     assert chans == expect
-    assert bool(why) == (given is None and verdict == "none")
+    assert bool(why) == (given is None and verdict in ("none", "unexplained"))
+
+
+def test_an_unexplained_verdict_fits_axle_3_accelerations_only_where_axle_3_is_the_reference():
+    """On the truck: 'axle3_acc' (its own calibration key); a drive logged on the front axle, or
+    one without axle 3's accelerations, keeps its default channels."""
+    from diagnosis.closed_loop import loop_channels
+    from inverse.run import fit_plan
+    from inverse.uncertainty import calibration_key
+
+    truck = [f"{q}_{a}{s}" for q in ("susp_disp", "axle_acc") for a in range(1, 5) for s in "LR"]
+    chans, why = loop_channels("unexplained", None, truck)
+    assert chans == "axle3_acc" and "axle accelerations" in why
+    sim, fitted = fit_plan(truck, chans)
+    assert set(fitted) == {"axle_acc_3L", "axle_acc_3R"} and {"susp_disp_3L", "susp_disp_3R"} <= set(sim)
+    assert calibration_key("linear", "axle3_acc") == ("linear/axle3_acc", True)
+    front = ["susp_disp_1L", "susp_disp_1R", "axle_acc_1L", "axle_acc_1R", "speed"]
+    assert loop_channels("unexplained", None, front) == (None, "")
+    # displacements of axle 1 only (the reference) but every axle's accelerations: not axle 3's set
+    front_acc = ["susp_disp_1L", "susp_disp_1R"] + [f"axle_acc_{a}{s}" for a in range(1, 5) for s in "LR"]
+    assert loop_channels("unexplained", None, front_acc) == (None, "")
+    no_acc3 = [c for c in truck if c not in ("axle_acc_3L", "axle_acc_3R")]
+    assert loop_channels("unexplained", None, no_acc3) == (None, "")
 
 
 def test_a_one_axle_drive_keeps_its_default_channels_and_says_why():
