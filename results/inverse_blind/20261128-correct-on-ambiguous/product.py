@@ -15,7 +15,8 @@ sys.path.insert(0, str(HERE.parents[2] / 'benchmarks'))
 sys.path.insert(0, str(HERE.parents[2]))
 from calibrate_uncertainty import accuracy, coverage, load  # noqa: E402
 
-from inverse import uncertainty as U  # noqa: E402
+sys.path.insert(0, str(HERE))
+from compose_unexplained import cov as cover  # noqa: E402
 
 OLD = {'seeds1-20': HERE.parent / '20261128-acceleration-only-fit' / 'closed-loop' / 'axle3'}
 #: the axle3_acc fits of each set's 'unexplained' drives (for seeds 1-20 the open-loop fits of stop 46)
@@ -25,17 +26,6 @@ ACC = {'seeds1-20': HERE.parent / '20261128-acceleration-only-fit' / 'axle3-acc'
 
 def records(root):
     return {json.loads(l)['seed']: json.loads(l) for l in (root / 'results.jsonl').read_text().splitlines()}
-
-
-def cover(groups):
-    tot = {q: [0.0, 0] for q in ('ln_Gq_n0', 'w', 'ln_G_n_best')}
-    for key, rows in groups.items():
-        if rows:
-            c = coverage(rows, U.calibration(key))
-            for q in tot:
-                tot[q][0] += c[q][0] * c[q][2]
-                tot[q][1] += c[q][2]
-    return ' / '.join(f'{100 * a / max(n, 1):.0f}' for a, n in tot.values())
 
 
 def main():
