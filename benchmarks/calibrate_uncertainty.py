@@ -88,7 +88,8 @@ def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool 
     Each row gets ``model_form`` (``inverse.uncertainty.MODEL_FORMS``) as
     ``diagnosis.closed_loop.model_form`` decides it from the record's ``closed_loop``
     (records without one: "open"), or the record's own ``closed_loop.model_form`` where it holds
-    one (records made after 2026-11-28: a correction with an 'ambiguous' name is "open"). ``loops`` (``{seed: (verdict, corrected)}``,
+    one (records made after 2026-11-28: a correction with an 'ambiguous' name is "open"). ``loops``
+    (``{seed: (verdict, corrected, singled out)}``,
     :func:`redecided_loops`) replaces the recorded verdicts: a drive corrected then and not
     now is scored on its nominal rows (with ``profile``, left out: the records keep the
     profile rows of the corrected inversion only)."""
@@ -102,7 +103,7 @@ def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool 
         loop = case.get("closed_loop")
         nominal_rows = open_loop and bool(case.get("nominal"))
         if loop and loops is not None and case["seed"] in loops:
-            verdict, corrected, singled = (tuple(loops[case["seed"]]) + (True,))[:3]
+            verdict, corrected, singled = loops[case["seed"]]
             if corrected and not loop.get("corrected"):
                 raise SystemExit(f"{root}: seed {case['seed']} would be corrected now and has no corrected record")
             nominal_rows = nominal_rows or (loop.get("corrected") and not corrected)

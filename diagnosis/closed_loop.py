@@ -125,9 +125,10 @@ def loop_channels(verdict: str | None, channels=None, available=None) -> tuple:
         return channels, ""
     if verdict == "unexplained":
         if available is not None:
-            from inverse.run import PREFERRED_AXLE, reference_axle
+            from inverse.run import PREFERRED_AXLE, axle_channels, reference_axle
+            acc = {c for c in axle_channels(PREFERRED_AXLE) if c.startswith("axle_acc_")}
             if (reference_axle(available) != PREFERRED_AXLE
-                    or not {"axle_acc_3L", "axle_acc_3R"} <= set(available)):
+                    or not acc <= set(available)):
                 return None, ""
         return CHANNELS_WHEN_UNEXPLAINED, ("a gap no library effect explains, so axle 3's axle accelerations "
                                            "alone are fitted (channel set 'axle3_acc'; the suspension "
