@@ -35,6 +35,55 @@ def test_a_named_effect_is_used_unless_its_value_is_a_bound(summary, expect):
         assert "edge of its search range (leaf_friction.force)" in reason
 
 
+def _unexplained(closest="leaf_friction", share=0.79, ranking="clear", edge=()):
+    return {"verdict": "unexplained", "verdict_confidence": "none",
+            "verdict_detail": {"closest": closest, "explained_share": share, "ranking_confidence": ranking,
+                               "edge": list(edge), "signature_agrees": False},
+            "ranking": [{"effect": "sensor", "parameters": {"sensor": {"cutoff": 10.3}}},
+                        {"effect": "leaf_friction", "parameters": {"leaf_friction": {"force": 2138.0}}},
+                        {"effect": "payload", "parameters": {"payload": {"mass": 900.0}}}]}
+
+
+@pytest.mark.parametrize("summary, expect", [
+    (_unexplained(), {"leaf_friction": {"force": 2138.0}}),
+    (_unexplained("payload", 0.6), {"payload": {"mass": 900.0}}),
+    (_unexplained(share=0.59), None),                       # below CLOSEST_SHARE_MIN
+    (_unexplained(ranking="ambiguous"), None),              # a rival within noise
+    (_unexplained(edge=["leaf_friction.force"]), None),     # a bound, not an estimate
+    (_unexplained("sensor", 0.85), None),                   # acts on the channels: a road cut looks alike
+    (_unexplained("tyre_enveloping", 0.9), None),           # acts on the road input
+    (_unexplained("nonexistent", 0.9), None),
+    ({**_unexplained(), "verdict_detail": {}}, None),
+])
+def test_an_unexplained_gap_is_corrected_only_with_a_dominant_closest_effect_on_the_vehicle(summary, expect):
+    """closest_vehicle_effect: an 'unexplained' verdict corrects with its closest effect only where
+    it changes the vehicle itself (suspension terms or masses), explains >= CLOSEST_SHARE_MIN of
+    the gap with a clear ranking and calibrates inside its range; the reason says the verdict,
+    the share and that something beyond it remains; the loop keeps the open model-form term."""
+    from diagnosis.closed_loop import CLOSEST_SHARE_MIN, closest_vehicle_effect, model_form, singled_out
+
+    assert CLOSEST_SHARE_MIN == 0.6
+    effects, reason = effects_from_diagnosis(summary)
+    assert effects == expect and "\n" not in reason
+    assert (closest_vehicle_effect(summary) is not None) == bool(expect)
+    if expect:
+        assert "answered 'unexplained'" in reason and f"{100 * summary['verdict_detail']['explained_share']:.0f} %" in reason
+        assert "something beyond it remains" in reason
+        assert model_form("unexplained", True, singled_out(summary)) == "open"
+    else:
+        assert "nominal model is kept" in reason
+
+
+def test_effects_on_the_vehicle_are_told_from_effects_on_road_and_channels():
+    """Effect.acts_on_vehicle follows the hooks an effect overrides: suspension terms or vehicle
+    parameters only -> True; the road the tyres see or the recorded channels -> False."""
+    from vehicles.effects import EFFECTS
+
+    on_vehicle = {n for n, e in EFFECTS.items() if e.acts_on_vehicle}
+    assert {"leaf_friction", "damper_asymmetry", "bump_stop", "frame_flex", "payload"} <= on_vehicle
+    assert not on_vehicle & {"sensor", "tyre_enveloping", "speed_scale"}
+
+
 @pytest.mark.parametrize("confidence, form", [("clear", "diagnosed"), ("ambiguous", "open")])
 def test_run_folder_with_a_given_diagnosis(tmp_path, confidence, form):
     """With a diagnosis that names leaf friction (given, so the test exercises the loop and not

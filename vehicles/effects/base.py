@@ -189,6 +189,20 @@ class Effect:
                     f"effect {self.name}: {name} = {v:g} {unit} is outside the range for vehicle "
                     f"{vp.id}: [{lo:g}, {hi:g}] {unit}" + (f" ({why})" if why else ""))
 
+    @property
+    def acts_on_vehicle(self) -> bool:
+        """Whether the effect changes the vehicle itself and nothing else: it overrides
+        :meth:`configure` or :meth:`suspension_terms` and neither :meth:`road` nor
+        :meth:`outputs`. An effect on the road the tyres see (tyre enveloping) or on the
+        recorded channels (a sensor low-pass, a speed scale) acts where the road model's own
+        parameters (level, waviness, band edges) act too, so a fit can trade one for the
+        other; one on the suspension or the masses cannot be mimicked by the road's
+        spectrum alone (used by :func:`diagnosis.closed_loop.effects_from_diagnosis`)."""
+        cls = type(self)
+        def own(hook):
+            return getattr(cls, hook) is not getattr(Effect, hook)
+        return (own("configure") or own("suspension_terms")) and not (own("road") or own("outputs"))
+
     def to_dict(self) -> dict:
         """JSON description (``eroad effects --json``)."""
         return {"name": self.name, "description": self.description, "primary": self.primary,
