@@ -103,12 +103,13 @@ def effects_from_diagnosis(summary: dict, action: str = "inverted") -> tuple[dic
 #: the share of the held-out gap (``verdict_detail.explained_share``) the closest library effect
 #: of an ``unexplained`` verdict must explain, with a clear ranking and an effect on the vehicle
 #: itself, for the loop to correct with it (:func:`closest_vehicle_effect`). Chosen on the saved
-#: blind diagnoses (2026-11-28; results/inverse_blind/20261128-closest-vehicle-effect/): of the
-#: `unexplained` verdicts whose closest effect explained >= 0.6 with a clear ranking, the 17 whose
-#: effect acts on the vehicle (suspension terms or masses) named the planted effect in all 17; at
-#: >= 0.5 three more came in, all wrong. The 15 whose closest effect acts on the road input or the
-#: recorded channels (sensor, tyre enveloping) were right in 3: a band-limited road (the measured
-#: profile) looks like a low-pass.
+#: blind diagnoses (2026-11-28; results/inverse_blind/20261128-closest-vehicle-effect/
+#: closest_names.py): of the 155 `unexplained` verdicts, the 12 whose closest effect acts on the
+#: vehicle (suspension terms or masses), explained >= 0.6 of the gap with a clear ranking and
+#: calibrated inside its range were all the planted effect; at >= 0.5 one more came in, wrong
+#: (a damper asymmetry for a leaf friction of the independent truck). The 15 such verdicts whose
+#: closest effect acts on the road input or the recorded channels (sensor, tyre enveloping) were
+#: right in 3: the independent truck on a band-limited road looks like a sensor low-pass.
 CLOSEST_SHARE_MIN = 0.6
 
 
