@@ -190,7 +190,7 @@ def loop_channels(verdict: str | None, channels=None, available=None) -> tuple:
             if (reference_axle(available) != PREFERRED_AXLE
                     or not acc <= set(available)):
                 return None, ""
-        return CHANNELS_WHEN_UNEXPLAINED, ("a gap no library effect explains, so axle 3's axle accelerations "
+        return CHANNELS_WHEN_UNEXPLAINED, ("a gap no library effect fully explains, so axle 3's axle accelerations "
                                            "alone are fitted (channel set 'axle3_acc'; the suspension "
                                            "displacements, where the body's motion shows, only segment the drive)")
     if verdict == "none":

@@ -85,7 +85,7 @@ ROAD_MODEL_NOTE = (
 #: the sentence of Table 1's note per model-form state (:data:`inverse.uncertainty.MODEL_FORMS`)
 MODEL_FORM_NOTE = {
     "open": ("Model-form term: 'open' -- a vehicle difference may be unaccounted for (the model was not "
-             "checked against this drive, the diagnosis found a gap no library effect explains, or the "
+             "checked against this drive, the diagnosis found a gap no library effect fully explains, or the "
              "effect this fit carries is the nearest one the diagnosis named without singling it out), so "
              "the intervals allow for it hiding in the road level (`eroad invert --effects auto` "
              "diagnoses first)."),
