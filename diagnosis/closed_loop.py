@@ -76,12 +76,12 @@ def effects_from_diagnosis(summary: dict, action: str = "inverted") -> tuple[dic
             return None, "the diagnosis answered 'unexplained': the nominal model is kept"
         params, share = closest
         name = next(iter(params))
-        text = ", ".join(f"{k}." + ", ".join(f"{p}={v:.4g}" for p, v in d.items()) for k, d in params.items())
-        return params, (f"the diagnosis answered 'unexplained' (no library effect passed both of its tests), but "
+        why = ("its road-independent signature does not agree" if detail.get("signature_agrees") is False
+               else "the verdict's other tests did not single it out")
+        return params, (f"the diagnosis answered 'unexplained' (no library effect passed all of its tests), but "
                         f"its closest effect, {name}, changes the vehicle itself and explains "
-                        f"{100 * share:.0f} % of the held-out gap with a clear ranking; {action} with {text} "
-                        f"as the nearest description of the vehicle (its road-independent signature does not "
-                        f"agree: something beyond it remains)")
+                        f"{100 * share:.0f} % of the held-out gap with a clear ranking; {action} with {_describe(params)} "
+                        f"as the nearest description of the vehicle ({why}: something beyond it may remain)")
     if verdict in ("none", None):
         return None, f"the diagnosis answered '{verdict}': the nominal model is kept"
     identified = bool(detail.get("identified"))
@@ -90,11 +90,10 @@ def effects_from_diagnosis(summary: dict, action: str = "inverted") -> tuple[dic
         return None, (f"the diagnosis named {verdict} but it calibrates at the edge of its search range "
                       f"({', '.join(map(str, edge))}): the value is a bound, not an estimate, so the "
                       f"nominal model is kept")
-    entry = next((r for r in summary.get("ranking", []) if r.get("effect") == verdict), None)
-    if entry is None or not entry.get("parameters"):
+    params = _ranking_parameters(summary, verdict)
+    if params is None:
         return None, f"the diagnosis named {verdict} but recorded no calibrated parameters: nominal model kept"
-    params = {str(k): {str(p): float(v) for p, v in d.items()} for k, d in entry["parameters"].items()}
-    text = ", ".join(f"{k}." + ", ".join(f"{p}={v:.4g}" for p, v in d.items()) for k, d in params.items())
+    text = _describe(params)
     how = ("confidence clear" if conf == "clear" else "identified; a difference beyond it remains"
            if identified else f"confidence '{conf}': not singled out, the nearest library effect")
     return params, f"the diagnosis named {verdict} ({how}); {action} with {text}"
@@ -139,11 +138,21 @@ def closest_vehicle_effect(summary: dict) -> tuple[dict, float] | None:
     if (name not in EFFECTS or not EFFECTS[name].acts_on_vehicle or detail.get("ranking_confidence") != "clear"
             or share is None or share < CLOSEST_SHARE_MIN or detail.get("edge")):
         return None
-    entry = next((r for r in summary.get("ranking", []) if r.get("effect") == name), None)
+    params = _ranking_parameters(summary, name)
+    return None if params is None else (params, float(share))
+
+
+def _ranking_parameters(summary: dict, effect: str) -> dict | None:
+    """The calibrated parameters of ``effect``'s own ranking entry, ``{effect: {parameter: value}}``."""
+    entry = next((r for r in summary.get("ranking", []) if r.get("effect") == effect), None)
     if entry is None or not entry.get("parameters"):
         return None
-    params = {str(k): {str(p): float(v) for p, v in d.items()} for k, d in entry["parameters"].items()}
-    return params, float(share)
+    return {str(k): {str(p): float(v) for p, v in d.items()} for k, d in entry["parameters"].items()}
+
+
+def _describe(params: dict) -> str:
+    """``effect.parameter=value, ...`` for the reason line."""
+    return ", ".join(f"{k}." + ", ".join(f"{p}={v:.4g}" for p, v in d.items()) for k, d in params.items())
 
 
 #: the channels the closed loop fits where the diagnosis answers ``none`` and the caller chose

@@ -47,6 +47,8 @@ def _unexplained(closest="leaf_friction", share=0.79, ranking="clear", edge=()):
 @pytest.mark.parametrize("summary, expect", [
     (_unexplained(), {"leaf_friction": {"force": 2138.0}}),
     (_unexplained("payload", 0.6), {"payload": {"mass": 900.0}}),
+    ({**_unexplained(), "verdict_detail": {**_unexplained()["verdict_detail"], "signature_agrees": None}},
+     {"leaf_friction": {"force": 2138.0}}),
     (_unexplained(share=0.59), None),                       # below CLOSEST_SHARE_MIN
     (_unexplained(ranking="ambiguous"), None),              # a rival within noise
     (_unexplained(edge=["leaf_friction.force"]), None),     # a bound, not an estimate
@@ -68,7 +70,8 @@ def test_an_unexplained_gap_is_corrected_only_with_a_dominant_closest_effect_on_
     assert (closest_vehicle_effect(summary) is not None) == bool(expect)
     if expect:
         assert "answered 'unexplained'" in reason and f"{100 * summary['verdict_detail']['explained_share']:.0f} %" in reason
-        assert "something beyond it remains" in reason
+        assert "something beyond it may remain" in reason
+        assert ("signature does not agree" in reason) == (summary["verdict_detail"].get("signature_agrees") is False)
         assert model_form("unexplained", True, singled_out(summary)) == "open"
     else:
         assert "nominal model is kept" in reason
