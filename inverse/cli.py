@@ -57,11 +57,13 @@ def register(subparsers) -> None:
                    help="effect added to the nominal model (repeatable), e.g. leaf_friction")
     p.add_argument("--effects", choices=("auto",), default=None,
                    help="auto: run the gap diagnosis first (RUN/diagnose) and, if it names an effect "
-                        "with confidence 'clear', invert with it at its calibrated value; the nominal "
-                        "inversion goes to RUN/nominal and Table 1 side by side to "
-                        "RUN/tables/table1_nominal_vs_corrected.md; where it finds no gap, the accelerations "
-                        "of every axle are fitted (--channels axles) unless --channels is given (about 3-4x "
-                        "the time)")
+                        "(any confidence, its value inside the search range), invert with it at its "
+                        "calibrated value; the nominal inversion goes to RUN/nominal and Table 1 side by "
+                        "side to RUN/tables/table1_nominal_vs_corrected.md. Where it finds no gap, the "
+                        "accelerations of every axle are fitted (--channels axles); where the gap is "
+                        "unexplained, axle 3's accelerations alone (--channels axle3_acc), corrected with "
+                        "the closest effect if it acts on the vehicle and explains >= 60 %% of the gap; a "
+                        "--channels given is kept (about 3-4x the time)")
     p.add_argument("--noise", action="append", default=[], metavar="NAME=SD",
                    help="known white sensor noise, standard deviation in the channel's SI unit, for a "
                         "channel (susp_disp_3L=1e-4) or a quantity (axle_acc=0.03); repeatable; channels "
