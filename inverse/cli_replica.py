@@ -27,7 +27,9 @@ def register(subparsers) -> None:
                    help="effects of the vehicle model: linear ones enter the linear model, leaf_friction by "
                         "statistical linearisation (equivalent damping from the measured suspension velocity), "
                         "other nonlinear ones are left out and listed; 'auto': run the diagnosis first and use "
-                        "the effect it names with confidence (RUN/diagnose/)")
+                        "the effect it names (any confidence, its value inside the search range), or, on an "
+                        "unexplained gap, its closest effect where that acts on the vehicle and explains >= 60 %% "
+                        "of the gap (RUN/diagnose/)")
     p.add_argument("--noise", action="append", default=[], metavar="NAME=SD",
                    help="known white sensor noise (sd, SI unit) per channel or quantity, e.g. axle_acc=0.03; "
                         "repeatable; the rest is estimated from the top of each spectrum")
