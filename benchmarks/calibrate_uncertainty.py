@@ -111,6 +111,8 @@ def load(root: Path, min_s: float = 3.0, profile: bool = False, open_loop: bool 
                     "model_form": model_form(verdict, corrected, singled)}
         form = "open" if not loop or (nominal_rows and loop.get("corrected")) else \
             loop.get("model_form") or model_form(loop.get("verdict"), bool(loop.get("corrected")))
+        if loop and loop.get("verdict") == "unexplained" and not nominal_rows:
+            form = "unexplained"      # today's state (records before stop 48 hold "open")
         if profile:
             was_corrected = bool((case.get("closed_loop") or {}).get("corrected"))
             segs = [] if nominal_rows and was_corrected else profile_rows(case, min_s)
@@ -148,8 +150,10 @@ def calibrate(rows: list) -> dict:
 
 def reported_sd(r, q, sd_lap, const) -> float:
     """inverse.uncertainty's formula with the constants in ``const`` (BETA_DIAGNOSED for a row
-    whose model form is "diagnosed")."""
-    beta = const["BETA_DIAGNOSED"] if r.get("model_form") == "diagnosed" else const["BETA"]
+    whose model form is "diagnosed", BETA_UNEXPLAINED where the set has one for an "unexplained" row)."""
+    form = r.get("model_form")
+    beta = (const["BETA_DIAGNOSED"] if form == "diagnosed" else
+            const.get("BETA_UNEXPLAINED", const["BETA"]) if form == "unexplained" else const["BETA"])
     return U.reported_sd(sd_lap, misfit(r), q, kappa=const["KAPPA"], beta=beta, r_ref=const["R_REF"])
 
 

@@ -224,15 +224,19 @@ def model_form(verdict: str | None, corrected: bool, singled: bool = True) -> st
     """The model-form state of a closed loop's reported inversion
     (:data:`inverse.uncertainty.MODEL_FORMS`): "diagnosed" where the diagnosis found no gap
     beyond noise (``none``) or named an effect it singled out (``singled``,
-    :func:`singled_out`) that the inversion then carries (``corrected``); "open" where a
-    vehicle difference may be left unaccounted for: a gap no library effect explains
-    (``unexplained``; on the measured road profile the smaller term covered ln G(n_best) in 6
-    of 10 fitted segments, docs/inverse.md section 11), an effect named at an edge of its
-    search range (not carried, :func:`effects_from_diagnosis`), or a correction with a name
+    :func:`singled_out`) that the inversion then carries (``corrected``); "unexplained" where
+    the gap is one no library effect fully explains, corrected or not (its own term where the
+    fitted channels have one, ``BETA_UNEXPLAINED`` of axle 3's accelerations, set on the saved
+    loops' unexplained drives with the measured-road segments as a second check; else the open
+    term -- the diagnosed one covered ln G(n_best) in 6 of 10 measured-road segments, docs/inverse.md
+    section 11); "open" where a vehicle difference may be left unaccounted for: an effect named at
+    an edge of its search range (not carried, :func:`effects_from_diagnosis`), or a correction with a name
     short of that (``ambiguous``: the nearest library effect, which may leave part of the
     difference in the road -- on 20 fresh friction drives with a flexible frame the smaller
     term covered ln G(n_best) in 82 % of the segments, the open one on those corrections in
     86 %; results/inverse_blind/20261128-correct-on-ambiguous/)."""
+    if verdict == "unexplained":
+        return "unexplained"
     return "diagnosed" if verdict == "none" or (corrected and singled) else "open"
 
 

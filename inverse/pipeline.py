@@ -77,7 +77,7 @@ class InversionConfig:
         Most simulate-and-refit rounds of the "linear" fit (0: linear model alone);
         at least ``inverse.linear_features.CORRECTIONS_NONLINEAR`` (4) when the
         simulator has nonlinear effects the linear model leaves out.
-    model_form : {"open", "diagnosed"}
+    model_form : {"open", "diagnosed", "unexplained"}
         Which model-form term the reported uncertainty carries
         (:data:`inverse.uncertainty.MODEL_FORMS`): "diagnosed" where the diagnosis found no
         gap on this drive or named and singled out the effect the fit carries

@@ -89,6 +89,10 @@ MODEL_FORM_NOTE = {
              "effect this fit carries is the nearest one the diagnosis named without singling it out), so "
              "the intervals allow for it hiding in the road level (`eroad invert --effects auto` "
              "diagnoses first)."),
+    "unexplained": ("Model-form term: 'unexplained' -- the diagnosis found a gap no library effect fully "
+                    "explains (this fit carries the closest effect only where it acts on the vehicle and "
+                    "explains most of the gap), so the intervals carry the term calibrated on such drives "
+                    "of the closed loop (the open one where the fitted channels have none)."),
     "diagnosed": ("Model-form term: 'diagnosed' -- the diagnosis found no gap beyond noise, or named and "
                   "singled out the effect this fit carries, so the intervals carry the smaller term calibrated on "
                   "diagnosed drives."),

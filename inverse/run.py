@@ -263,10 +263,11 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     bar : tqdm.tqdm, optional
         Progress bar (:func:`eroad.progress.progress_bar`), advanced per fit
         iteration and per candidate realisation.
-    model_form : {"open", "diagnosed"}
+    model_form : {"open", "diagnosed", "unexplained"}
         The model-form term of the reported intervals (:data:`inverse.uncertainty.MODEL_FORMS`):
         "open" unless the diagnosis found no gap on this drive or named and singled out the effect
-        this fit carries (``diagnosis.closed_loop.model_form`` sets it); recorded in
+        this fit carries ("diagnosed"), or found a gap no library effect fully explains
+        ("unexplained"); ``diagnosis.closed_loop.model_form`` sets it; recorded in
         ``summary["fit"]["model_form"]``.
     segment_on : {"displacement", "axle_acc"}
         What the segment boundaries are located on (:class:`inverse.pipeline.InversionConfig`):

@@ -61,7 +61,7 @@ def test_an_unexplained_gap_is_corrected_only_with_a_dominant_closest_effect_on_
     """closest_vehicle_effect: an 'unexplained' verdict corrects with its closest effect only where
     it changes the vehicle itself (suspension terms or masses), explains >= CLOSEST_SHARE_MIN of
     the gap with a clear ranking and calibrates inside its range; the reason says the verdict,
-    the share and that something beyond it remains; the loop keeps the open model-form term."""
+    the share and that something beyond it remains; the intervals carry the 'unexplained' term."""
     from diagnosis.closed_loop import CLOSEST_SHARE_MIN, closest_vehicle_effect, model_form, singled_out
 
     assert CLOSEST_SHARE_MIN == 0.6
@@ -72,7 +72,7 @@ def test_an_unexplained_gap_is_corrected_only_with_a_dominant_closest_effect_on_
         assert "answered 'unexplained'" in reason and f"{100 * summary['verdict_detail']['explained_share']:.0f} %" in reason
         assert "something beyond it may remain" in reason
         assert ("signature does not agree" in reason) == (summary["verdict_detail"].get("signature_agrees") is False)
-        assert model_form("unexplained", True, singled_out(summary)) == "open"
+        assert model_form("unexplained", True, singled_out(summary)) == "unexplained"
     else:
         assert "nominal model is kept" in reason
 

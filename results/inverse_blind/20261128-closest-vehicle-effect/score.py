@@ -6,7 +6,8 @@ Before: the loop of stop 47 as composed by ../20261128-correct-on-ambiguous/prod
 every name corrects, 'unexplained' drives fitted on axle 3's accelerations without a correction.
 After: the 'unexplained' drives whose closest effect qualifies (diagnosis.closed_loop.
 closest_vehicle_effect; seeds 12, 37 and 38) replaced by their rerun with the same diagnoses
-(same-drives/, `bench_inverse.py --effects-auto --diagnoses`), all other drives unchanged.
+(same-drives/, `bench_inverse.py --effects-auto --diagnoses`), all other drives unchanged; every
+'unexplained' drive's intervals with the 'unexplained' model-form term (before: the open one).
 With two closed-loop roots given (fresh drives): each scored as it is, and paired."""
 import json
 import sys
@@ -71,11 +72,14 @@ def saved():
                     rec[s]['closed_loop']['confidence'] == 'clear' or ident[str(s)]):
                 r['model_form'] = 'open'
         acc = [r for r in load(ACC[name]) if verdict.get(r['seed']) == 'unexplained']
-        before = {'linear': [r for r in rows if verdict[r['seed']] != 'unexplained'], 'linear/axle3_acc': acc}
+        # before: stop 47's loop, whose 'unexplained' drives carried the open term
+        before = {'linear': [r for r in rows if verdict[r['seed']] != 'unexplained'],
+                  'linear/axle3_acc': [dict(r, model_form='open') for r in acc]}
         redo = load(HERE / 'same-drives' / name)
         seeds = {r['seed'] for r in redo}
+        # after: today's, the 'unexplained' term (BETA_UNEXPLAINED) on every such drive
         after = {'linear': before['linear'],
-                 'linear/axle3_acc': [r for r in acc if r['seed'] not in seeds] + redo}
+                 'linear/axle3_acc': [dict(r, model_form='unexplained') for r in acc if r['seed'] not in seeds] + redo}
         b, a = line(f"{name} before", before), line(f"{name} after ", after)
         paired(b, a)
         pooled['before'].append(before)
