@@ -170,6 +170,32 @@ def test_beta_diagnosed_rule_picks_the_smallest_value_that_covers_90_percent():
     assert C.choose_beta_diagnosed(rows, const) == {"ln_Gq_n0": 0.1, "w": 0.1, "ln_G_n_best": 0.1}
 
 
+def test_scoring_reads_an_unexplained_loop_in_todays_state(tmp_path):
+    """benchmarks/calibrate_uncertainty.py: a closed-loop record with verdict 'unexplained' is scored
+    in the 'unexplained' state even where it recorded 'open' (records before stop 48), and its
+    interval then takes BETA_UNEXPLAINED of the constants given; a record without a loop stays
+    'open'."""
+    import json
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    import calibrate_uncertainty as C
+
+    seg = {"duration_s": 5.0, "lnGq_err": 0.1, "w_err": 0.0, "lnG_n_best_err": 0.1, "sd_ln_Gq_n0": 0.1,
+           "sd_w": 0.1, "sd_ln_G_n_best": 0.1, "objective": 40.0, "n_features": 10}
+    recs = [{"seed": 1, "segments": [dict(seg)], "closed_loop": {"verdict": "unexplained", "corrected": False,
+                                                                  "model_form": "open"}},
+            {"seed": 2, "segments": [dict(seg)]}]
+    (tmp_path / "results.jsonl").write_text("\n".join(json.dumps(r) for r in recs))
+    rows = C.load(tmp_path)
+    assert [r["model_form"] for r in rows] == ["unexplained", "open"]
+    const = U.calibration("linear/axle3_acc")
+    sd_u = C.reported_sd(rows[0], "ln_Gq_n0", 0.1, const)
+    sd_o = C.reported_sd(dict(rows[0], model_form="open"), "ln_Gq_n0", 0.1, const)
+    assert sd_u < sd_o
+
+
 def test_calibration_key_per_channel_set():
     """Each channel set takes its own constants where they were calibrated (the 'axles' set of
     the linear fit: its correlated channels need a larger KAPPA); any other list falls back to
