@@ -1,6 +1,6 @@
 """The friction drives' closed loop before and after the closest-effect rule, segments >= 3 s
-(python results/inverse_blind/20261128-closest-vehicle-effect/score.py [FRESH_BEFORE FRESH_AFTER],
-from the repository root).
+(python results/inverse_blind/20261128-closest-vehicle-effect/score.py [FRESH_ROOT], from the
+repository root).
 
 Before: the loop of stop 47 as composed by ../20261128-correct-on-ambiguous/product.py ('new'):
 every name corrects, 'unexplained' drives fitted on axle 3's accelerations without a correction.
@@ -8,7 +8,7 @@ After: the 'unexplained' drives whose closest effect qualifies (diagnosis.closed
 closest_vehicle_effect; seeds 12, 37 and 38) replaced by their rerun with the same diagnoses
 (same-drives/, `bench_inverse.py --effects-auto --diagnoses`), all other drives unchanged; every
 'unexplained' drive's intervals with the 'unexplained' model-form term (before: the open one).
-With two closed-loop roots given (fresh drives): each scored as it is, and paired."""
+With a closed-loop root run with the rule (fresh drives): before / after on it, see :func:`fresh`."""
 import json
 import sys
 from pathlib import Path
@@ -52,13 +52,6 @@ def paired(before, after):
           f"{sum(c(A[k]) and not c(B[k]) for k in ks)}")
 
 
-def grouped(rows, root):
-    """Rows by calibration key, from the records' channel set ('unexplained' -> axle3_acc)."""
-    rec = records(root)
-    acc = [r for r in rows if rec[r['seed']].get('closed_loop', {}).get('verdict') == 'unexplained']
-    return {'linear/axle3_acc': acc, 'linear': [r for r in rows if r not in acc]}
-
-
 def saved():
     pooled = {'before': [], 'after': []}
     for name in ('seeds1-20', 'seeds21-40'):
@@ -88,16 +81,36 @@ def saved():
         line(f"pooled {label}", {k: sum((d[k] for d in ds), []) for k in ds[0]})
 
 
-def fresh(before_root, after_root):
-    b = load(Path(before_root))
-    a = load(Path(after_root))
-    line(f"{before_root}", grouped(b, before_root))
-    line(f"{after_root}", grouped(a, after_root))
+def fresh(root):
+    """A closed-loop root run with the rule: after = its records as they are; before = stop 47's loop
+    on the same drives, i.e. where the rule corrected an 'unexplained' drive its nominal inversion
+    (same channels, recorded beside the corrected one), and every 'unexplained' drive with the open
+    term."""
+    root = Path(root)
+    rec = records(root)
+    verdict = {s: (c.get('closed_loop') or {}).get('verdict') for s, c in rec.items()}
+    fired = sorted(s for s, c in rec.items() if verdict[s] == 'unexplained' and c['closed_loop'].get('corrected'))
+    print(f"{root}: verdicts {sorted(set(verdict.values()), key=str)}; 'unexplained' drives corrected by the rule: {fired}")
+    after_rows = load(root)
+    nominal = {key(r): r for r in load(root, open_loop=True) if r['seed'] in fired}
+    before_rows = [dict(r, model_form='open') for r in nominal.values()] + [
+        dict(r, model_form='open') if verdict[r['seed']] == 'unexplained' else r
+        for r in after_rows if r['seed'] not in fired]
+
+    def grouped_rows(rows):
+        return {'linear/axles': [r for r in rows if verdict[r['seed']] == 'none'],
+                'linear/axle3_acc': [r for r in rows if verdict[r['seed']] == 'unexplained'],
+                'linear': [r for r in rows if verdict[r['seed']] not in ('none', 'unexplained')]}
+    b = line('before (stop 47)', grouped_rows(before_rows))
+    a = line('after (today)   ', grouped_rows(after_rows))
     paired(b, a)
+    for s in fired:
+        print(f"  seed {s}: ln G(1) " + ' '.join(f"{r['lnG_1cpm_err']:+.2f}" for r in before_rows if r['seed'] == s)
+              + ' -> ' + ' '.join(f"{r['lnG_1cpm_err']:+.2f}" for r in after_rows if r['seed'] == s))
 
 
 if __name__ == '__main__':
-    if len(sys.argv) == 3:
-        fresh(*sys.argv[1:])
+    if len(sys.argv) == 2:
+        fresh(sys.argv[1])
     else:
         saved()
