@@ -151,9 +151,7 @@ def calibrate(rows: list) -> dict:
 def reported_sd(r, q, sd_lap, const) -> float:
     """inverse.uncertainty's formula with the constants in ``const`` (BETA_DIAGNOSED for a row
     whose model form is "diagnosed", BETA_UNEXPLAINED where the set has one for an "unexplained" row)."""
-    form = r.get("model_form")
-    beta = (const["BETA_DIAGNOSED"] if form == "diagnosed" else
-            const.get("BETA_UNEXPLAINED", const["BETA"]) if form == "unexplained" else const["BETA"])
+    beta = U.beta_of(const, r.get("model_form") or "open")
     return U.reported_sd(sd_lap, misfit(r), q, kappa=const["KAPPA"], beta=beta, r_ref=const["R_REF"])
 
 

@@ -45,7 +45,7 @@ from inverse import uncertainty as U  # noqa: E402
 def interval_holds(r: dict, key: str) -> dict:
     """Per quantity, whether the row's 90 % interval (constants ``key``, its model form) holds."""
     c = U.calibration(key)
-    beta = c["BETA_DIAGNOSED"] if r["model_form"] == "diagnosed" else c["BETA"]
+    beta = U.beta_of(c, r["model_form"])
     out = {}
     for q, (err, sd) in QUANTITIES.items():
         if r.get(err) is None or not sd(r):

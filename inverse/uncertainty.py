@@ -258,10 +258,16 @@ def model_form_beta(fit_model: str = "simulation", model_form: str = "open") -> 
     """The model-form constants BETA of ``fit_model`` in the state ``model_form`` (``MODEL_FORMS``)."""
     if model_form not in MODEL_FORMS:
         raise ValueError(f"model_form must be one of {MODEL_FORMS}, got {model_form!r}")
-    c = calibration(fit_model)
+    return beta_of(calibration(fit_model), model_form)
+
+
+def beta_of(constants: dict, model_form: str = "open") -> dict:
+    """The BETA of a set of calibration constants (a :data:`CALIBRATIONS` entry, or a trial set
+    of ``benchmarks/calibrate_uncertainty.py``) in the state ``model_form``: BETA_DIAGNOSED for
+    "diagnosed", BETA_UNEXPLAINED for "unexplained" where the set has one, else the open BETA."""
     if model_form == "unexplained":
-        return c.get("BETA_UNEXPLAINED", c["BETA"])
-    return c["BETA_DIAGNOSED"] if model_form == "diagnosed" else c["BETA"]
+        return constants.get("BETA_UNEXPLAINED", constants["BETA"])
+    return constants["BETA_DIAGNOSED"] if model_form == "diagnosed" else constants["BETA"]
 
 
 def honest_sd(sd_laplace: dict, sd_ln_G_n_best: float | None, objective: float, n_features: int,
