@@ -163,6 +163,20 @@ def at_bounds(Gq_n0: float, w: float, bounds) -> list:
     return out
 
 
+def unresolved_row(segment_s: float, resolution: dict) -> dict | None:
+    """summary.json's ``unresolved`` of one segment: ``piece_s`` (3 s) and ``ln_level`` [lo, hi],
+    the ln level ratio range within which a stretch of that length inside the segment is, as often
+    as not, left in it by the segmentation (:func:`inverse.segmentation.unresolved_level`; None for
+    an unbounded side); None where it does not apply (segment not longer than the piece, or
+    boundaries located on several series)."""
+    from inverse.segmentation import UNRESOLVED_PIECE_S, unresolved_level
+
+    r = unresolved_level(UNRESOLVED_PIECE_S, segment_s, resolution)
+    if r is None:
+        return None
+    return {"piece_s": UNRESOLVED_PIECE_S, "ln_level": [v if math.isfinite(v) else None for v in r]}
+
+
 @dataclass
 class Inversion:
     """Result of :func:`invert`."""
@@ -194,7 +208,8 @@ class Inversion:
             ``sd_laplace`` and ``sd_ln_G_n_best_laplace`` the fit's noise-only ones;
             ``interval90`` the 90 % intervals of Gq_n0, w and G_n_best; ``fit_quality``
             the gate (status 'clean' or 'poor', misfit per feature); ``at_bound`` the
-            fitted level or waviness sitting on a bound of the fit (:func:`at_bounds`).
+            fitted level or waviness sitting on a bound of the fit (:func:`at_bounds`);
+            ``unresolved`` the segmentation's resolution (:func:`unresolved_row`).
         """
         from inverse.uncertainty import fit_quality, honest_sd, interval90
 
@@ -223,6 +238,7 @@ class Inversion:
                          "fit_quality": fit_quality(d["objective"], d["n_features"], fit_model=fm),
                          "objective": d["objective"], "n_features": d["n_features"], "converged": d["converged"],
                          "at_bound": at_bounds(d["Gq_n0"], d["w"], self.config.bounds),
+                         "unresolved": unresolved_row(float(tb[k + 1] - tb[k]), self.segmentation.resolution),
                          **{key: d[key] for key in ("sd_robust", "consistency") if key in d},
                          **best})
         return rows

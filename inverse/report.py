@@ -41,7 +41,9 @@ def table1(segments: list) -> pd.DataFrame:
         with the misfit per feature (:mod:`inverse.uncertainty`); where the run chose
         a road model per segment (:mod:`inverse.road_model`): road_model
         ('one_slope' / 'two_slope'), w_low, w_high, n_break [cycles/m] and
-        bic_gain_two_slope (ic_delta, > 0 chose two slopes).
+        bic_gain_two_slope (ic_delta, > 0 chose two slopes); unresolved_3s_level_x, the level
+        factor range of a 3 s stretch the segmentation leaves inside the segment as often as not
+        (``unresolved``, '' where it does not apply).
     """
     rows = []
     for i, s in enumerate(segments):
@@ -60,8 +62,26 @@ def table1(segments: list) -> pd.DataFrame:
                      **({"fit": s["fit_quality"]["status"],
                          "misfit_per_feature": round(s["fit_quality"]["misfit_per_feature"], 2)}
                         if "fit_quality" in s else {}),
-                     **(_road_model_columns(s) if "road_model" in s else {})})
+                     **(_road_model_columns(s) if "road_model" in s else {}),
+                     **({"unresolved_3s_level_x": _factor_range((s["unresolved"] or {}).get("ln_level"))}
+                        if "unresolved" in s else {})})
     return pd.DataFrame(rows)
+
+
+def _factor_range(ln_level) -> str:
+    """'0.29-2.5': the level ratio range of an ``unresolved`` row ('' where it does not apply)."""
+    if not ln_level:
+        return ""
+    lo, hi = ln_level
+    return "{}-{}".format("0" if lo is None else f"{np.exp(lo):.2g}", "inf" if hi is None else f"{np.exp(hi):.2g}")
+
+
+#: the note's sentence on the segmentation's resolution (Table 1's unresolved column)
+UNRESOLVED_NOTE = (
+    "unresolved_3s_level_x: a 3 s stretch inside the segment whose road level lies within this factor "
+    "range of the segment's is, as often as not, left in the segment by the segmentation (its "
+    "criterion's expected resolution, docs/inverse.md section 1); the segment's values and intervals "
+    "describe the segment as one road, so such a stretch's own level can lie outside them.")
 
 
 def _road_model_columns(s: dict) -> dict:
@@ -113,6 +133,8 @@ def table1_note(fit_quality: dict | None = None, road_model: bool = True, segmen
             "calibrated on blind drives (docs/inverse.md, section 11). 'fit' is the fit-quality gate: "
             f"'poor' where the misfit per feature exceeds {gate:g}, i.e. the model does not explain "
             "the segment's data and its numbers are not a clean result.")
+    if any((r or {}).get("unresolved") for r in segments or []):
+        note += " " + UNRESOLVED_NOTE
     if model_form is not None:
         note += " " + MODEL_FORM_NOTE[model_form]
     if channels is not None:

@@ -283,6 +283,10 @@ class SegmentationResult:
         ``boundary_source`` names other series).
     boundary_source : str
         What the boundaries were located on (the series partitioned), in words.
+    resolution : dict
+        What the criterion needs to say which pieces it cannot resolve
+        (:func:`unresolved_level`): n_eff, duration_s, penalty, n_par, series (how many
+        series were partitioned; the bound is derived for one).
     """
 
     t_bounds: np.ndarray
@@ -295,6 +299,7 @@ class SegmentationResult:
     criterion: dict = field(default_factory=dict)
     band: tuple = (3.0, 20.0)
     boundary_source: str = "suspension displacement in 3-20 Hz"
+    resolution: dict = field(default_factory=dict)
 
     @property
     def n_segments(self) -> int:
@@ -568,8 +573,51 @@ def segment(time, channels, speed, *, k=None, k_max: int | None = None, window_s
             classes.append(cls)
     else:
         classes = [""] * K
+    resolution = {"n_eff": float(n_eff), "duration_s": float(duration), "penalty": float(penalty), "n_par": n_par,
+                  "series": 1 if weights is None else int(y.shape[1])}
     return SegmentationResult(tb, classes, Gq, rms, vmean, t[::step], np.exp(logr[::step]), criterion,
-                              (f_hp, f_lp), series_label)
+                              (f_hp, f_lp), series_label, resolution)
+
+
+#: the shortest piece whose level the inversion's accuracy targets score (issue 14: segments >= 3 s)
+#: and for which each segment reports the level change the segmentation cannot resolve [s]
+UNRESOLVED_PIECE_S = 3.0
+
+
+def unresolved_level(piece_s: float, segment_s: float, resolution: dict) -> tuple | None:
+    """The range of ln power ratios a piece of ``piece_s`` seconds inside a segment of
+    ``segment_s`` seconds can have, against the rest of that segment, and still not be split
+    off by the penalised criterion of :func:`segment` (expected values).
+
+    Derivation (cost 'variance', one series): splitting a piece of m of the segment's s blocks
+    whose mean square is r times the rest's lowers the partition cost by
+    s ln(1 + f (r - 1)) - m ln r (f = m / s; the rest keeps its mean), scaled by n_eff / n in
+    the criterion; a piece inside the segment adds two pieces, i.e. 2 * penalty * n_par *
+    ln(n_eff). The piece stays unresolved while the first is below the second; the returned
+    (lo, hi) are the ln r where they are equal (lo < 0 < hi; -inf / inf where no ratio is
+    enough). For a linear response at one waviness and speed the response power ratio is the
+    road level ratio, so (lo, hi) bound how far the level of an unresolved 3 s stretch can lie
+    from its segment's.
+
+    Returns None where it does not apply: the segment is not longer than the piece, or several
+    series were partitioned (``segment_on`` 'axle_acc': each series sees the change
+    differently).
+    """
+    from scipy.optimize import brentq
+
+    if not resolution or resolution.get("series", 1) != 1 or segment_s <= piece_s:
+        return None
+    n_eff, dur = float(resolution["n_eff"]), float(resolution["duration_s"])
+    s_eff, m_eff, f = n_eff * segment_s / dur, n_eff * piece_s / dur, piece_s / segment_s
+    pen = 2.0 * float(resolution["penalty"]) * float(resolution["n_par"]) * math.log(n_eff)
+
+    def excess(x):     # criterion gain of splitting the piece off, less the penalty
+        return s_eff * math.log1p(f * math.expm1(x)) - m_eff * x - pen
+
+    lim = 30.0
+    hi = brentq(excess, 0.0, lim) if excess(lim) > 0 else math.inf
+    lo = brentq(excess, -lim, 0.0) if excess(-lim) > 0 else -math.inf
+    return float(lo), float(hi)
 
 
 def classify(rms: float, speed: float, predict_rms, w: float = 2.0, ref_class: str = "C"):

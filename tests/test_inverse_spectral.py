@@ -61,3 +61,16 @@ def test_parameters_on_a_bound_are_named_and_reach_table1_note():
     note = table1_note({"status": "clean"}, segments=[{"at_bound": []}, {"at_bound": pinned}])
     assert "On a bound" in note and "segment 2" in note and "segment 1" not in note
     assert "On a bound" not in table1_note({"status": "clean"}, segments=[{"at_bound": []}])
+
+
+def test_the_segmentations_resolution_reaches_table1_and_its_note():
+    """Each segment row's 'unresolved' becomes Table 1's factor column and one note sentence."""
+    from inverse.report import table1, table1_note
+
+    row = {"t_start": 0.0, "t_end": 12.0, "proportion": 1.0, "class": "C", "Gq_n0": 256e-6, "w": 2.0,
+           "nmin": 0.01, "nmax": 5.0, "dx": 0.1, "dy": 0.1, "identifiable": {},
+           "unresolved": {"piece_s": 3.0, "ln_level": [-1.2, 0.9]}}
+    t = table1([row, dict(row, unresolved={"piece_s": 3.0, "ln_level": [None, 0.9]}), dict(row, unresolved=None)])
+    assert list(t["unresolved_3s_level_x"]) == ["0.3-2.5", "0-2.5", ""]
+    assert "unresolved_3s_level_x" in table1_note({"status": "clean"}, segments=[row])
+    assert "unresolved_3s_level_x" not in table1_note({"status": "clean"}, segments=[dict(row, unresolved=None)])
