@@ -585,24 +585,39 @@ UNRESOLVED_PIECE_S = 3.0
 
 
 def unresolved_level(piece_s: float, segment_s: float, resolution: dict) -> tuple | None:
-    """The range of ln power ratios a piece of ``piece_s`` seconds inside a segment of
-    ``segment_s`` seconds can have, against the rest of that segment, and still not be split
-    off by the penalised criterion of :func:`segment` (expected values).
+    """The range of ln level a piece of ``piece_s`` seconds inside a segment of ``segment_s``
+    seconds can have, against the segment's mean level, and still not be split off by the
+    penalised criterion of :func:`segment` (expected values).
 
     Derivation (cost 'variance', one series): splitting a piece of m of the segment's s blocks
     whose mean square is r times the rest's lowers the partition cost by
     s ln(1 + f (r - 1)) - m ln r (f = m / s; the rest keeps its mean), scaled by n_eff / n in
     the criterion; a piece inside the segment adds two pieces, i.e. 2 * penalty * n_par *
-    ln(n_eff). The piece stays unresolved while the first is below the second; the returned
-    (lo, hi) are the ln r where they are equal (lo < 0 < hi; -inf / inf where no ratio is
-    enough). For a linear response at one waviness and speed the response power ratio is the
-    road level ratio, so (lo, hi) bound how far the level of an unresolved 3 s stretch can lie
-    from its segment's.
+    ln(n_eff). The piece stays unresolved while the first is below the second
+    (:func:`unresolved_ratio_to_rest` solves for the ln r where they are equal). Against the
+    segment's mean square, which a fit of the whole segment matches, the piece then lies
+    ln r - ln(1 + f (r - 1)) away: the returned (lo, hi), lo < 0 < hi (-inf / inf where no
+    ratio is enough). For a linear response at one waviness and speed a response power ratio is
+    a road level ratio, so (lo, hi) bound how far the level of an unresolved stretch can lie
+    from its segment's fitted level.
 
     Returns None where it does not apply: the segment is not longer than the piece, or several
     series were partitioned (``segment_on`` 'axle_acc': each series sees the change
     differently).
     """
+    r = unresolved_ratio_to_rest(piece_s, segment_s, resolution)
+    if r is None:
+        return None
+    f = piece_s / segment_s
+
+    def to_segment(x):
+        return x if not math.isfinite(x) else x - math.log1p(f * math.expm1(x))
+    return tuple(float(to_segment(x)) for x in r)
+
+
+def unresolved_ratio_to_rest(piece_s: float, segment_s: float, resolution: dict) -> tuple | None:
+    """(lo, hi): the ln power ratios of a piece against the REST of its segment at which the
+    criterion's gain from splitting it off equals the penalty (:func:`unresolved_level`)."""
     from scipy.optimize import brentq
 
     if not resolution or resolution.get("series", 1) != 1 or segment_s <= piece_s:

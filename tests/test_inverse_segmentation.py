@@ -302,30 +302,34 @@ def _drive_with_piece(ln_ratio: float, seed: int, fs: float = 200.0):
 
 
 def test_unresolved_level_is_where_the_criterion_gain_equals_its_penalty():
-    """Closed form: at the returned ratios the split's gain equals the two extra pieces' penalty;
-    the range narrows as the piece's share of the segment falls (the rest's mean barely moves)."""
-    from inverse.segmentation import unresolved_level
+    """Closed form: at the ratios to the rest the split's gain equals the two extra pieces'
+    penalty; against the segment's mean the piece lies ln r - ln(1 + f (r - 1)) away; the range
+    narrows as the piece's share of the segment falls (the rest's mean barely moves)."""
+    from inverse.segmentation import unresolved_level, unresolved_ratio_to_rest
 
     res = {"n_eff": 500.0, "duration_s": 30.0, "penalty": 1.0, "n_par": 2, "series": 1}
-    lo, hi = unresolved_level(3.0, 12.0, res)
+    lo, hi = unresolved_ratio_to_rest(3.0, 12.0, res)
     s_eff, m_eff, f = 500.0 * 12 / 30, 500.0 * 3 / 30, 3 / 12
     for x in (lo, hi):
         gain = s_eff * math.log(1 + f * (math.exp(x) - 1)) - m_eff * x
         assert gain == pytest.approx(4 * math.log(500.0), rel=1e-6)
-    lo30, hi30 = unresolved_level(3.0, 30.0, res)
+    seg = unresolved_level(3.0, 12.0, res)
+    assert seg == pytest.approx([x - math.log(1 + f * (math.exp(x) - 1)) for x in (lo, hi)], rel=1e-12)
+    assert lo < seg[0] < 0 < seg[1] < hi        # the segment's mean moves towards the piece
+    lo30, hi30 = unresolved_ratio_to_rest(3.0, 30.0, res)
     assert lo < lo30 < 0 < hi30 < hi
     assert unresolved_level(3.0, 3.0, res) is None                 # segment not longer than the piece
     assert unresolved_level(3.0, 12.0, dict(res, series=6)) is None  # several series: not derived
 
 
 def test_unresolved_level_is_the_segmenters_median_detection_point():
-    """The bound against segment() itself: a 3 s piece at half the bound (in ln) is split off in
-    at most 2 of 10 drives, at 1.6 times it in at least 9 of 10 (measured 0-1 / 20 and 20 / 20;
-    at the bound 12-14 / 20, as an expected-value bound should be)."""
-    from inverse.segmentation import segment, unresolved_level
+    """The bound against segment() itself: a 3 s piece at half the bound (ln ratio to the rest)
+    is split off in at most 2 of 10 drives, at 1.6 times it in at least 9 of 10 (measured 0-1 / 20
+    and 20 / 20; at the bound 12-14 / 20, as an expected-value bound should be)."""
+    from inverse.segmentation import segment, unresolved_ratio_to_rest
 
     t, x = _drive_with_piece(0.0, 0)
-    lo, hi = unresolved_level(3.0, 30.0, segment(t, {"a": x}, 10.0).resolution)
+    lo, hi = unresolved_ratio_to_rest(3.0, 30.0, segment(t, {"a": x}, 10.0).resolution)
 
     def split_off(ln_ratio, seed):
         t, x = _drive_with_piece(ln_ratio, seed)
