@@ -15,10 +15,10 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from resolution_check import LOOP_KEY, U, fitted_segments, load, reported_sd, unresolved_level  # noqa: E402
+from resolution_check import U, calibration_key, fitted_segments, load, reported_sd, unresolved_level  # noqa: E402
 
 SETS = {'null 1-20': '/tmp/s45/base-null', 'null 21-60': '/tmp/s45/base-null2', 'null 61-100': '/tmp/s45/base-null3',
-        'null 1-20 axles': '/tmp/s46/axles-data-null@linear/axles', 'friction 1-20': '/tmp/s46/cl-axle3',
+        'null 1-20 axles': '/tmp/s46/axles-data-null', 'friction 1-20': '/tmp/s46/cl-axle3',
         'friction 21-40': '/tmp/s47/fresh-random', 'friction 41-60': '/tmp/s48/fresh-random',
         'independent 1-20': '/tmp/s47/cl-second', 'independent 41-52': '/tmp/s47/fresh-second',
         'independent 53-72': '/tmp/s48/fresh-second'}
@@ -36,8 +36,7 @@ def pieces(spec):
         if not segs:
             continue
         g, res = segs[0]
-        loop = rec[r['seed']].get('closed_loop')
-        const = U.calibration(LOOP_KEY.get(loop.get('verdict'), 'linear') if loop else (key or 'linear'))
+        const = U.calibration(calibration_key(rec[r['seed']], res, key))
         z = (U.Z90 * reported_sd(r, 'ln_Gq_n0', r['sd_laplace']['ln_Gq_n0'], const),
              U.Z90 * reported_sd(r, 'ln_G_n_best', r['sd_ln_G_n_best_laplace'], const))
         lh = unresolved_level(3.0, g['t_end'] - g['t_start'], res) or (0.0, 0.0)

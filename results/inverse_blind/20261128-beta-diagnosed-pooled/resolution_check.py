@@ -4,8 +4,9 @@ roots with their run-N/summary.json):
 
     python results/inverse_blind/20261128-beta-diagnosed-pooled/resolution_check.py NAME=ROOT[@KEY] ...
 
-(KEY: the calibration key of an open-loop root, inverse.uncertainty.CALIBRATIONS, default
-'linear'; closed-loop roots take each drive's from its verdict as merges.py does.)
+(Each row's interval constants: the calibration its run's summary.json names; runs that predate
+that field take KEY, inverse.uncertainty.CALIBRATIONS, default 'linear', or in a closed loop the
+key its verdict chooses, as merges.py does.)
 
 For every true segment >= 3 s that shares its fitted segment with another true segment (the
 segmentation merged them), two offsets against the range unresolved_level gives for a piece of
@@ -39,6 +40,15 @@ from inverse.segmentation import unresolved_level  # noqa: E402
 LOOP_KEY = {'none': 'linear/axles', 'unexplained': 'linear/axle3_acc'}
 
 
+def calibration_key(case, res, key=None):
+    """The uncertainty calibration the run used (its summary's), else the closed loop's choice by
+    verdict (LOOP_KEY), else ``key`` or 'linear'."""
+    if res.get('key'):
+        return res['key']
+    loop = case.get('closed_loop')
+    return LOOP_KEY.get(loop.get('verdict'), 'linear') if loop else (key or 'linear')
+
+
 def fitted_segments(run):
     out = []
     for p in (run / 'summary.json', run / 'nominal' / 'summary.json'):
@@ -46,7 +56,8 @@ def fitted_segments(run):
             s = json.loads(p.read_text())
             crit = s['segmentation']['criterion']
             res = {'n_eff': crit['n_eff'], 'duration_s': s['segments'][-1]['t_end'] - s['segments'][0]['t_start'],
-                   'penalty': 1.0, 'n_par': 2, 'series': 1 if 'axle_acc' not in s['segmentation'].get('boundaries_from', '') else 0}
+                   'penalty': 1.0, 'n_par': 2, 'series': 1 if 'axle_acc' not in s['segmentation'].get('boundaries_from', '') else 0,
+                   'key': s['fit'].get('uncertainty_calibration')}
             out += [(g, res) for g in s['segments']]
     return out
 
@@ -78,8 +89,7 @@ def check(root, key=None):
         off = -r['lnGq_err']
         grp = groups[(r['seed'], r['Gq_fit'])]
         mix = math.log(sum(q['duration_s'] * math.exp(ln_g(q)) for q in grp) / sum(q['duration_s'] for q in grp))
-        loop = rec[r['seed']].get('closed_loop')
-        const = U.calibration(LOOP_KEY.get(loop.get('verdict'), 'linear') if loop else (key or 'linear'))
+        const = U.calibration(calibration_key(rec[r['seed']], res, key))
         # the envelope around the fitted values, with today's reported sd of the row's channel set
         # and model form, widened by the reported range of a 3 s piece
         z_sd = U.Z90 * reported_sd(r, 'ln_Gq_n0', r['sd_laplace']['ln_Gq_n0'], const)
