@@ -141,6 +141,13 @@ def test_pipeline_on_luliang_like_drive():
                  predict_rms=quarter_predict_rms(),
                  config=InversionConfig(seed=0, segment_on="axle_acc", fit=FitConfig(max_iter=1)))
     assert alt.summary()["segmentation"]["boundaries_from"].startswith("axle_acc_3L, axle_acc_3R in 6-12")
+    # every segment longer than 3 s states the segmentation's resolution (lo < 0 < hi); with the
+    # boundaries on several series it is not derived (None)
+    for r in summ["segments"]:
+        if r["t_end"] - r["t_start"] > 3.0:
+            lo, hi = r["unresolved"]["ln_level"]
+            assert r["unresolved"]["piece_s"] == 3.0 and lo < 0.0 < hi
+    assert all(r["unresolved"] is None for r in alt.summary()["segments"])
 
 
 class _PhaseRedrawingSimulator:
