@@ -8,14 +8,13 @@ and the segment's reported range (lo, hi) for a 3 s piece. Variants of an interv
 z of the same mean width. If the range carried information on which segments hide a piece, 'quad'
 would cover more than the common factor at equal width. Pieces of our truck (null and friction
 drives) and of the independent truck apart; ln Gq(n0) / ln G(n_best)."""
-import json
 import math
 import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from resolution_check import U, calibration_key, fitted_segments, load, reported_sd, unresolved_level  # noqa: E402
+from resolution_check import scored_pieces, unresolved_level  # noqa: E402
 
 SETS = {'null 1-20': '/tmp/s45/base-null', 'null 21-60': '/tmp/s45/base-null2', 'null 61-100': '/tmp/s45/base-null3',
         'null 1-20 axles': '/tmp/s46/axles-data-null', 'friction 1-20': '/tmp/s46/cl-axle3',
@@ -26,19 +25,8 @@ SETS = {'null 1-20': '/tmp/s45/base-null', 'null 21-60': '/tmp/s45/base-null2', 
 
 def pieces(spec):
     root, _, key = spec.partition('@')
-    root = Path(root)
-    rec = {json.loads(li)['seed']: json.loads(li) for li in (root / 'results.jsonl').read_text().splitlines()}
     out = []
-    for r in load(root, min_s=0.0):
-        if r['duration_s'] < 3.0:
-            continue
-        segs = [(g, res) for g, res in fitted_segments(root / f"run-{r['seed']}") if g['Gq_n0'] == r['Gq_fit']]
-        if not segs:
-            continue
-        g, res = segs[0]
-        const = U.calibration(calibration_key(rec[r['seed']], res, key))
-        z = (U.Z90 * reported_sd(r, 'ln_Gq_n0', r['sd_laplace']['ln_Gq_n0'], const),
-             U.Z90 * reported_sd(r, 'ln_G_n_best', r['sd_ln_G_n_best_laplace'], const))
+    for r, g, res, z in scored_pieces(root, key or None)[0]:
         lh = unresolved_level(3.0, g['t_end'] - g['t_start'], res) or (0.0, 0.0)
         if all(map(math.isfinite, lh)):
             out.append(((-r['lnGq_err'], -r['lnG_n_best_err']), z, lh))

@@ -62,6 +62,28 @@ def fitted_segments(run):
     return out
 
 
+def scored_pieces(root, key=None):
+    """(row, fitted segment, its resolution inputs, z90 half-widths of ln Gq(n0) and ln G(n_best)
+    with the constants the run used) for every true piece >= 3 s whose fitted segment is found,
+    and the rows of every length (to tell which pieces share a fitted segment)."""
+    root = Path(root)
+    rec = {json.loads(li)['seed']: json.loads(li) for li in (root / 'results.jsonl').read_text().splitlines()}
+    rows = load(root, min_s=0.0)
+    out = []
+    for r in rows:
+        if r['duration_s'] < 3.0:
+            continue
+        segs = [(g, res) for g, res in fitted_segments(root / f"run-{r['seed']}") if g['Gq_n0'] == r['Gq_fit']]
+        if not segs:
+            continue
+        g, res = segs[0]
+        const = U.calibration(calibration_key(rec[r['seed']], res, key))
+        z = (U.Z90 * reported_sd(r, 'ln_Gq_n0', r['sd_laplace']['ln_Gq_n0'], const),
+             U.Z90 * reported_sd(r, 'ln_G_n_best', r['sd_ln_G_n_best_laplace'], const))
+        out.append((r, g, res, z))
+    return out, rows
+
+
 N_SEG = 0.3   # cycles/m
 
 
@@ -70,30 +92,19 @@ def ln_g(r, n=N_SEG):
 
 
 def check(root, key=None):
-    root = Path(root)
-    rec = {json.loads(li)['seed']: json.loads(li) for li in (root / 'results.jsonl').read_text().splitlines()}
-    rows = load(root, min_s=0.0)
+    pieces, rows = scored_pieces(root, key)
     n = Counter((r['seed'], r['Gq_fit']) for r in rows)
     groups = {}
     for r in rows:
         groups.setdefault((r['seed'], r['Gq_fit']), []).append(r)
     merged, alone = [], []
-    for r in rows:
-        if r['duration_s'] < 3.0:
-            continue
-        segs = [(g, res) for g, res in fitted_segments(root / f"run-{r['seed']}") if g['Gq_n0'] == r['Gq_fit']]
-        if not segs:
-            continue
-        g, res = segs[0]
+    for r, g, res, (z_sd, z_nb) in pieces:
         lo_hi = unresolved_level(r['duration_s'], g['t_end'] - g['t_start'], res)
         off = -r['lnGq_err']
         grp = groups[(r['seed'], r['Gq_fit'])]
         mix = math.log(sum(q['duration_s'] * math.exp(ln_g(q)) for q in grp) / sum(q['duration_s'] for q in grp))
-        const = U.calibration(calibration_key(rec[r['seed']], res, key))
-        # the envelope around the fitted values, with today's reported sd of the row's channel set
-        # and model form, widened by the reported range of a 3 s piece
-        z_sd = U.Z90 * reported_sd(r, 'ln_Gq_n0', r['sd_laplace']['ln_Gq_n0'], const)
-        z_nb = U.Z90 * reported_sd(r, 'ln_G_n_best', r['sd_ln_G_n_best_laplace'], const)
+        # the envelope around the fitted values (today's reported sd of the run's channel set and
+        # model form) widened by the reported range of a 3 s piece
         u = unresolved_row(g['t_end'] - g['t_start'], res)
         elo, ehi = u['ln_level'] if u else (0.0, 0.0)
         elo, ehi = -math.inf if elo is None else elo, math.inf if ehi is None else ehi
