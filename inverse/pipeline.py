@@ -165,10 +165,10 @@ def at_bounds(Gq_n0: float, w: float, bounds) -> list:
 
 def unresolved_row(segment_s: float, resolution: dict) -> dict | None:
     """summary.json's ``unresolved`` of one segment: ``piece_s`` (3 s) and ``ln_level`` [lo, hi],
-    the range of ln level, against the segment's, within which a stretch of that length inside the
-    segment is, as often as not, left in it by the segmentation (:func:`inverse.segmentation.unresolved_level`; None for
-    an unbounded side); None where it does not apply (segment not longer than the piece, or
-    boundaries located on several series)."""
+    the range of ln level, against the segment's, within which a stretch of that length inside
+    the segment is, as often as not, left in it by the segmentation
+    (:func:`inverse.segmentation.unresolved_level`; None for an unbounded side); None where it
+    does not apply (segment not longer than the piece, K given, boundaries on several series)."""
     from inverse.segmentation import UNRESOLVED_PIECE_S, unresolved_level
 
     r = unresolved_level(UNRESOLVED_PIECE_S, segment_s, resolution)

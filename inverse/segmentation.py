@@ -286,7 +286,8 @@ class SegmentationResult:
     resolution : dict
         What the criterion needs to say which pieces it cannot resolve
         (:func:`unresolved_level`): n_eff, duration_s, penalty, n_par, series (how many
-        series were partitioned; the bound is derived for one).
+        series were partitioned; the bound is derived for one), k_given (K was given, not
+        chosen by the criterion).
     """
 
     t_bounds: np.ndarray
@@ -574,7 +575,7 @@ def segment(time, channels, speed, *, k=None, k_max: int | None = None, window_s
     else:
         classes = [""] * K
     resolution = {"n_eff": float(n_eff), "duration_s": float(duration), "penalty": float(penalty), "n_par": n_par,
-                  "series": 1 if weights is None else int(y.shape[1])}
+                  "series": 1 if weights is None else int(y.shape[1]), "k_given": k is not None}
     return SegmentationResult(tb, classes, Gq, rms, vmean, t[::step], np.exp(logr[::step]), criterion,
                               (f_hp, f_lp), series_label, resolution)
 
@@ -601,9 +602,9 @@ def unresolved_level(piece_s: float, segment_s: float, resolution: dict) -> tupl
     a road level ratio, so (lo, hi) bound how far the level of an unresolved stretch can lie
     from its segment's fitted level.
 
-    Returns None where it does not apply: the segment is not longer than the piece, or several
-    series were partitioned (``segment_on`` 'axle_acc': each series sees the change
-    differently).
+    Returns None where it does not apply: the segment is not longer than the piece, the number
+    of segments was given (no criterion chose it), or several series were partitioned
+    (``segment_on`` 'axle_acc': each series sees the change differently).
     """
     r = unresolved_ratio_to_rest(piece_s, segment_s, resolution)
     if r is None:
@@ -620,7 +621,8 @@ def unresolved_ratio_to_rest(piece_s: float, segment_s: float, resolution: dict)
     criterion's gain from splitting it off equals the penalty (:func:`unresolved_level`)."""
     from scipy.optimize import brentq
 
-    if not resolution or resolution.get("series", 1) != 1 or segment_s <= piece_s:
+    if (not resolution or resolution.get("series", 1) != 1 or resolution.get("k_given")
+            or segment_s <= piece_s):
         return None
     n_eff, dur = float(resolution["n_eff"]), float(resolution["duration_s"])
     s_eff, m_eff, f = n_eff * segment_s / dur, n_eff * piece_s / dur, piece_s / segment_s

@@ -320,6 +320,7 @@ def test_unresolved_level_is_where_the_criterion_gain_equals_its_penalty():
     assert lo < lo30 < 0 < hi30 < hi
     assert unresolved_level(3.0, 3.0, res) is None                 # segment not longer than the piece
     assert unresolved_level(3.0, 12.0, dict(res, series=6)) is None  # several series: not derived
+    assert unresolved_level(3.0, 12.0, dict(res, k_given=True)) is None  # K given: no criterion chose it
 
 
 def test_unresolved_level_is_the_segmenters_median_detection_point():
@@ -330,6 +331,7 @@ def test_unresolved_level_is_the_segmenters_median_detection_point():
 
     t, x = _drive_with_piece(0.0, 0)
     lo, hi = unresolved_ratio_to_rest(3.0, 30.0, segment(t, {"a": x}, 10.0).resolution)
+    assert unresolved_ratio_to_rest(3.0, 30.0, segment(t, {"a": x}, 10.0, k=1).resolution) is None
 
     def split_off(ln_ratio, seed):
         t, x = _drive_with_piece(ln_ratio, seed)
