@@ -149,10 +149,12 @@ def calibrate(rows: list) -> dict:
 
 
 def reported_sd(r, q, sd_lap, const) -> float:
-    """inverse.uncertainty's formula with the constants in ``const`` (BETA_DIAGNOSED for a row
-    whose model form is "diagnosed", BETA_UNEXPLAINED where the set has one for an "unexplained" row)."""
-    beta = U.beta_of(const, r.get("model_form") or "open")
-    return U.reported_sd(sd_lap, misfit(r), q, kappa=const["KAPPA"], beta=beta, r_ref=const["R_REF"])
+    """inverse.uncertainty's formula with the constants in ``const`` (BETA_DIAGNOSED and, where the
+    set has one, FLOOR_DIAGNOSED for a row whose model form is "diagnosed", BETA_UNEXPLAINED where
+    the set has one for an "unexplained" row)."""
+    form = r.get("model_form") or "open"
+    return U.reported_sd(sd_lap, misfit(r), q, kappa=const["KAPPA"], beta=U.beta_of(const, form),
+                         r_ref=const["R_REF"], floor=U.floor_of(const, form))
 
 
 def choose_beta(rows: list, const: dict, grid=(0.0, 0.01, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5)) -> dict:
@@ -179,6 +181,24 @@ def choose_beta_diagnosed(rows: list, const: dict, grid=(0.0, 0.01, 0.03, 0.05, 
         for b in grid:
             if coverage(rows, {**const, "BETA_DIAGNOSED": {**const["BETA_DIAGNOSED"], q: b}})[q][0] >= 0.90 - 1e-9:
                 out[q] = b
+                break
+    return out
+
+
+def choose_floor_diagnosed(rows: list, const: dict,
+                           grid=(0.0, 0.005, 0.01, 0.02, 0.03, 0.05, 0.08, 0.1, 0.15, 0.2)) -> dict:
+    """Per quantity, the smallest grid value of FLOOR_DIAGNOSED (a model-form variance that does
+    not scale with the misfit, added to the reported sd^2 of "diagnosed" rows, BETA_DIAGNOSED kept)
+    at which 90 % of the intervals of ``rows`` (their "diagnosed" rows) hold; the last grid value
+    if none does."""
+    rows = [r for r in rows if r.get("model_form") == "diagnosed"]
+    out = {}
+    for q in QUANTITIES:
+        out[q] = grid[-1]
+        for f in grid:
+            trial = {**const, "FLOOR_DIAGNOSED": {**const.get("FLOOR_DIAGNOSED", {}), q: f}}
+            if coverage(rows, trial)[q][0] >= 0.90 - 1e-9:
+                out[q] = f
                 break
     return out
 

@@ -93,22 +93,31 @@ def test_each_fit_model_has_its_own_calibration():
 
 
 def test_a_diagnosed_drive_carries_the_smaller_model_form_term():
-    """Above the reference misfit the model-form variance is BETA_DIAGNOSED where the diagnosis
-    found no gap or the fit carries the named effect, BETA where a vehicle difference may be
-    left ('open', the default); at or below it neither term adds anything; an unknown state is
-    refused. The diagnosed constants are smaller for every quantity (the term exists because
-    an unchecked model can hide a vehicle difference in the road level)."""
+    """Above the reference misfit the misfit-scaled model-form variance is BETA_DIAGNOSED where
+    the diagnosis found no gap or the fit carries the named effect, BETA where a vehicle
+    difference may be left ('open', the default); at or below it neither adds anything; the
+    axle-3 fit's 'diagnosed' state adds FLOOR_DIAGNOSED whatever the misfit (a corrected gap
+    leaves level bias the misfit does not show, stop 49); an unknown state is refused. The
+    diagnosed BETA is smaller for every quantity (the term exists because an unchecked model can
+    hide a vehicle difference in the road level)."""
     lin = U.calibration("linear")
+    fl = lin["FLOOR_DIAGNOSED"]
     lap = {"ln_Gq_n0": 0.1, "w": 0.05}
     hi = dict(objective=4 * lin["R_REF"] * 10, n_features=10, fit_model="linear")
     op = U.honest_sd(lap, 0.04, **hi)
     dg = U.honest_sd(lap, 0.04, model_form="diagnosed", **hi)
     for q, v in (("ln_Gq_n0", 0.1), ("w", 0.05), ("ln_G_n_best", 0.04)):
         assert lin["BETA_DIAGNOSED"][q] < lin["BETA"][q]
-        assert dg[q] == pytest.approx(math.sqrt((2 * lin["KAPPA"][q] * v) ** 2 + 3 * lin["BETA_DIAGNOSED"][q]))
+        assert 0 < fl[q] < 3 * lin["BETA"][q]
+        assert dg[q] == pytest.approx(math.sqrt((2 * lin["KAPPA"][q] * v) ** 2 + 3 * lin["BETA_DIAGNOSED"][q] + fl[q]))
         assert op[q] == pytest.approx(math.sqrt((2 * lin["KAPPA"][q] * v) ** 2 + 3 * lin["BETA"][q]))
     lo = dict(objective=0.5 * lin["R_REF"] * 10, n_features=10, fit_model="linear")
-    assert U.honest_sd(lap, 0.04, model_form="diagnosed", **lo) == U.honest_sd(lap, 0.04, **lo)
+    op_lo, dg_lo = U.honest_sd(lap, 0.04, **lo), U.honest_sd(lap, 0.04, model_form="diagnosed", **lo)
+    for q in ("ln_Gq_n0", "w", "ln_G_n_best"):
+        assert dg_lo[q] == pytest.approx(math.sqrt(op_lo[q] ** 2 + fl[q]))
+    # no floor on a channel set without one ('axles': the 'none' verdict's fit)
+    ax = dict(lo, fit_model="linear/axles")
+    assert U.honest_sd(lap, 0.04, model_form="diagnosed", **ax) == U.honest_sd(lap, 0.04, **ax)
     with pytest.raises(ValueError, match="model_form"):
         U.honest_sd(lap, 0.04, model_form="closed", **lo)
     assert "'diagnosed'" in table1_note({"status": "clean"}, model_form="diagnosed")
