@@ -114,8 +114,10 @@ MODEL_FORM_NOTE = {
                     "explains most of the gap), so the intervals carry the term calibrated on such drives "
                     "of the closed loop (the open one where the fitted channels have none)."),
     "diagnosed": ("Model-form term: 'diagnosed' -- the diagnosis found no gap beyond noise, or named and "
-                  "singled out the effect this fit carries, so the intervals carry the smaller term calibrated on "
-                  "diagnosed drives."),
+                  "singled out the effect this fit carries, so the intervals carry the term calibrated on "
+                  "diagnosed drives: smaller than the open one where the misfit is high, plus (axle-3 fit) a "
+                  "floor whatever the misfit, because what a correction leaves can bias the level without "
+                  "raising the misfit."),
 }
 
 
