@@ -16,7 +16,7 @@ the reported standard deviation is the Laplace one scaled up (Birge's ratio, as 
 least-squares metrology when the residual exceeds its expectation) plus a model-form
 variance that grows with the misfit beyond a correct model's:
 
-    sd^2 = (KAPPA[q] sd_laplace)^2 max(1, r / R_REF) + BETA[q] max(0, r / R_REF - 1)
+    sd^2 = (KAPPA[q] sd_laplace)^2 max(1, r / R_REF) + BETA[q] max(0, r / R_REF - 1) [+ FLOOR[q]]
 
 ``R_REF`` is the median misfit per feature of correctly modelled drives and ``KAPPA``
 the factor that makes the 90 % intervals cover the truth in 90 % of segments of those
@@ -25,7 +25,10 @@ gap (`random`: leaf friction and a flexible frame), where the Birge factor alone
 30-73 % (``benchmarks/bench_inverse.py``, ``benchmarks/calibrate_uncertainty.py``, results
 and commands in ``results/inverse_blind/``; docs/inverse.md, section 11). A model gap that
 leaves the misfit near a correct model's is not seen by any of this: about 1 in 5
-segments of those drives; the diagnosis and ``--effects auto`` are the remedy.
+segments of those drives; the diagnosis and ``--effects auto`` are the remedy. What the
+remedy leaves (the axle-3 fit of a drive corrected with a diagnosed effect) keeps a level
+bias the misfit does not show either; that state adds ``FLOOR[q]`` (``FLOOR_DIAGNOSED``,
+:func:`floor_of`) whatever the misfit.
 
 The gate: a segment whose ``r`` exceeds ``R_GATE`` (5 R_REF; 6 % of the segments of the
 correctly modelled drives exceed it, all where the stationary segment model does not hold)
