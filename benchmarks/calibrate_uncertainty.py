@@ -152,9 +152,7 @@ def reported_sd(r, q, sd_lap, const) -> float:
     """inverse.uncertainty's formula with the constants in ``const`` (BETA_DIAGNOSED and, where the
     set has one, FLOOR_DIAGNOSED for a row whose model form is "diagnosed", BETA_UNEXPLAINED where
     the set has one for an "unexplained" row)."""
-    form = r.get("model_form") or "open"
-    return U.reported_sd(sd_lap, misfit(r), q, kappa=const["KAPPA"], beta=U.beta_of(const, form),
-                         r_ref=const["R_REF"], floor=U.floor_of(const, form))
+    return U.state_sd(sd_lap, misfit(r), q, const, r.get("model_form") or "open")
 
 
 def choose_beta(rows: list, const: dict, grid=(0.0, 0.01, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5)) -> dict:

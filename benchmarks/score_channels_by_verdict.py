@@ -45,13 +45,11 @@ from inverse import uncertainty as U  # noqa: E402
 def interval_holds(r: dict, key: str) -> dict:
     """Per quantity, whether the row's 90 % interval (constants ``key``, its model form) holds."""
     c = U.calibration(key)
-    beta = U.beta_of(c, r["model_form"])
     out = {}
     for q, (err, sd) in QUANTITIES.items():
         if r.get(err) is None or not sd(r):
             continue
-        s = U.reported_sd(sd(r), misfit(r), q, kappa=c["KAPPA"], beta=beta, r_ref=c["R_REF"])
-        out[q] = abs(r[err]) <= U.Z90 * s
+        out[q] = abs(r[err]) <= U.Z90 * U.state_sd(sd(r), misfit(r), q, c, r["model_form"])
     return out
 
 

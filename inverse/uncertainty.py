@@ -271,10 +271,23 @@ def reported_sd(sd_laplace: float, misfit: float, param: str, *, kappa: dict | N
     beta = BETA if beta is None else beta
     x = misfit / (R_REF if r_ref is None else r_ref)
     k = kappa.get(param, kappa["ln_Gq_n0"])
-    b = beta.get(param, beta["ln_Gq_n0"] if param.startswith("ln_") else 0.0)
-    f = (floor or {}).get(param, (floor or {}).get("ln_Gq_n0", 0.0) if param.startswith("ln_") else 0.0)
+    b, f = _model_form_variance(beta, param), _model_form_variance(floor or {}, param)
     return max(math.sqrt((k * sd_laplace) ** 2 * max(1.0, x) + b * max(0.0, x - 1.0) + f),
                SD_FLOOR.get(param, 0.0))
+
+
+def _model_form_variance(term: dict, param: str) -> float:
+    """A model-form term's value for ``param``: its own, else the level's for another logarithm
+    (ln_nmin, ln_nmax), else none."""
+    return term.get(param, term.get("ln_Gq_n0", 0.0) if param.startswith("ln_") else 0.0)
+
+
+def state_sd(sd_laplace: float, misfit: float, param: str, constants: dict, model_form: str = "open") -> float:
+    """:func:`reported_sd` with a set of calibration constants (a :data:`CALIBRATIONS` entry or a
+    trial set of ``benchmarks/calibrate_uncertainty.py``) in the state ``model_form``: its KAPPA
+    and R_REF, :func:`beta_of` and :func:`floor_of` -- the one place a state picks its terms."""
+    return reported_sd(sd_laplace, misfit, param, kappa=constants["KAPPA"], beta=beta_of(constants, model_form),
+                       r_ref=constants["R_REF"], floor=floor_of(constants, model_form))
 
 
 def model_form_beta(fit_model: str = "simulation", model_form: str = "open") -> dict:
@@ -322,13 +335,13 @@ def honest_sd(sd_laplace: dict, sd_ln_G_n_best: float | None, objective: float, 
     dict
         Same keys as ``sd_laplace`` (scaled) plus ``ln_G_n_best`` when given [ln units or -].
     """
+    if model_form not in MODEL_FORMS:
+        raise ValueError(f"model_form must be one of {MODEL_FORMS}, got {model_form!r}")
     r = objective / max(int(n_features), 1)
     c = calibration(fit_model)
-    kw = dict(kappa=c["KAPPA"], beta=model_form_beta(fit_model, model_form), r_ref=c["R_REF"],
-              floor=floor_of(c, model_form))
-    out = {k: reported_sd(v, r, k, **kw) for k, v in sd_laplace.items()}
+    out = {k: state_sd(v, r, k, c, model_form) for k, v in sd_laplace.items()}
     if sd_ln_G_n_best is not None:
-        out["ln_G_n_best"] = reported_sd(sd_ln_G_n_best, r, "ln_G_n_best", **kw)
+        out["ln_G_n_best"] = state_sd(sd_ln_G_n_best, r, "ln_G_n_best", c, model_form)
     return out
 
 
