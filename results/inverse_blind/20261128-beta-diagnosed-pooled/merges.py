@@ -36,9 +36,14 @@ LOOPS = {  # closed-loop sets (bench_inverse.py --effects-auto)
 KEY = {'none': 'linear/axles', 'unexplained': 'linear/axle3_acc'}
 
 
+def sharing(rows):
+    """How many true pieces got each fitted segment's values, keyed (seed, fitted Gq_n0); pass the
+    rows of every length (load(..., min_s=0)): a piece is merged where its count is above 1."""
+    return Counter((r['seed'], r['Gq_fit']) for r in rows)
+
+
 def tagged(rows, root):
-    # a neighbour of any length counts (resolution_check.py's definition)
-    n = Counter((r['seed'], r['Gq_fit']) for r in load(Path(root), min_s=0.0))
+    n = sharing(load(Path(root), min_s=0.0))     # a neighbour of any length counts
     for r in rows:
         r['shares'] = n[(r['seed'], r['Gq_fit'])] > 1
     return rows

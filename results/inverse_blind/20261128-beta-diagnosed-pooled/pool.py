@@ -14,13 +14,14 @@ benchmarks/calibrate_uncertainty.py choose_beta_diagnosed: per quantity the smal
 which 90 % of the pooled diagnosed intervals hold."""
 import json
 import sys
-from collections import Counter
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[2] / 'benchmarks'))
+sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parents[2]))
 from calibrate_uncertainty import choose_beta_diagnosed, coverage, load  # noqa: E402
+from merges import sharing  # noqa: E402
 
 from inverse import uncertainty as U  # noqa: E402
 
@@ -38,7 +39,7 @@ def diagnosed_rows(root):
     rec = {json.loads(li)['seed']: json.loads(li) for li in (root / 'results.jsonl').read_text().splitlines()}
     ident = json.loads((root / 'identified.json').read_text()) if (root / 'identified.json').is_file() else None
     out = {'linear': [], 'linear/axles': []}
-    shared = Counter((r['seed'], r['Gq_fit']) for r in load(root, min_s=0.0))
+    shared = sharing(load(root, min_s=0.0))
     for r in load(root):
         r['merged'] = shared[(r['seed'], r['Gq_fit'])] > 1
         loop = rec[r['seed']].get('closed_loop') or {}

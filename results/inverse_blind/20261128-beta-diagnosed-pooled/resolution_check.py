@@ -25,19 +25,19 @@ criterion, n_eff; recorded runs predate the summary field):
 import json
 import math
 import sys
-from collections import Counter
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[2] / 'benchmarks'))
+sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parents[2]))
 from calibrate_uncertainty import load, reported_sd  # noqa: E402
 
 from inverse import uncertainty as U  # noqa: E402
 from inverse.pipeline import unresolved_row  # noqa: E402
 from inverse.segmentation import unresolved_level  # noqa: E402
+from merges import KEY as LOOP_KEY, sharing  # noqa: E402
 
-LOOP_KEY = {'none': 'linear/axles', 'unexplained': 'linear/axle3_acc'}
 
 
 def calibration_key(case, res, key=None):
@@ -93,7 +93,7 @@ def ln_g(r, n=N_SEG):
 
 def check(root, key=None):
     pieces, rows = scored_pieces(root, key)
-    n = Counter((r['seed'], r['Gq_fit']) for r in rows)
+    n = sharing(rows)
     groups = {}
     for r in rows:
         groups.setdefault((r['seed'], r['Gq_fit']), []).append(r)
