@@ -21,7 +21,7 @@ sys.path.insert(0, str(HERE.parents[2] / 'benchmarks'))
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parents[2]))
 from calibrate_uncertainty import choose_beta_diagnosed, coverage, load  # noqa: E402
-from merges import sharing  # noqa: E402
+from merges import KEY, sharing  # noqa: E402
 
 from inverse import uncertainty as U  # noqa: E402
 
@@ -31,7 +31,6 @@ SETS = {'friction 1-20': AMB / 'seeds1-20', 'friction 21-40': AMB / 'seeds21-40'
         'friction 41-60': CVE / 'fresh-friction-41-60',
         'independent 1-20': AMB / 'independent-cl', 'independent 41-52': AMB / 'independent-41-52',
         'independent 53-72': CVE / 'fresh-independent-53-72'}
-KEYS = {'none': 'linear/axles'}     # every other diagnosed drive is fitted on axle 3 ('linear')
 
 
 def diagnosed_rows(root):
@@ -48,7 +47,7 @@ def diagnosed_rows(root):
             continue
         if ident is not None and v != 'none' and not (loop.get('confidence') == 'clear' or ident[str(r['seed'])]):
             continue          # an 'ambiguous' correction: the open term (product.py)
-        out[KEYS.get(v, 'linear')].append(r)
+        out[KEY.get(v, 'linear')].append(r)     # diagnosed: 'none' on axles, a name on axle 3
     return out
 
 
