@@ -14,7 +14,7 @@ the true value.
 So the loop profiles the effect's primary parameter on that objective: the inversion is run
 again at the value times and divided by :data:`STEP`; while the lowest objective sits at an end
 of the values tried it steps on that way (at most :data:`MAX_STEPS` steps from the diagnosis's
-value and :data:`MAX_EXTRA_RUNS` runs beyond the first, never outside the parameter's advertised
+value, so at most MAX_STEPS + 1 runs beyond the first; never outside the parameter's advertised
 range); the run with the lowest objective is the loop's result. The segmentation and the fitted features do not depend on the vehicle model, so
 the objectives of the runs compare like with like (checked: the runs' feature counts must agree).
 
@@ -43,8 +43,6 @@ STEP = 1.3
 #: fresh friction drives); a search let run to four steps ran away to 1000-1200 N on three of 17
 #: drives (true 2000 N) and lost G(1) there
 MAX_STEPS = 2
-#: runs beyond the first (the diagnosis's value): the two neighbours and one step on
-MAX_EXTRA_RUNS = 3
 
 
 #: the effects whose value the loop profiles, and the parameter profiled
@@ -69,11 +67,11 @@ def profiled_parameter(effects: dict) -> tuple[str, str, float, tuple] | None:
 
 
 def profile(objective_at: Callable[[float], float], value: float, bounds: tuple,
-            step: float = STEP, max_extra: int = MAX_EXTRA_RUNS, max_steps: int = MAX_STEPS) -> dict:
+            step: float = STEP, max_steps: int = MAX_STEPS) -> dict:
     """Profile ``objective_at`` (the inversion's objective with the parameter at a value) around
     ``value``: its neighbours at ``value * step**(+-1)``, then further steps while the lowest
-    objective is at an end of the values tried, within ``bounds``, ``max_steps`` steps of
-    ``value`` and ``max_extra`` runs.
+    objective is at an end of the values tried, within ``bounds`` and ``max_steps`` steps of
+    ``value`` (at most ``max_steps + 2`` runs in all).
 
     Returns ``{"values": [...], "objectives": [...], "best": index}`` in the order evaluated
     (the first is ``value``)."""
@@ -85,7 +83,7 @@ def profile(objective_at: Callable[[float], float], value: float, bounds: tuple,
 
     def run(v: float) -> bool:
         v = min(max(v, lo), hi)
-        if v <= 0.0 or tried(v) or len(values) > max_extra:
+        if v <= 0.0 or tried(v):
             return False
         values.append(v)
         objs.append(objective_at(v))
@@ -93,7 +91,7 @@ def profile(objective_at: Callable[[float], float], value: float, bounds: tuple,
 
     run(value / step)
     run(value * step)
-    while len(values) <= max_extra:
+    while True:
         best = min(range(len(values)), key=objs.__getitem__)
         v = values[best]
         if v == max(values):

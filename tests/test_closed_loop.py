@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import tomllib
+from pathlib import Path
 
 import pytest
 
@@ -249,3 +250,34 @@ def test_a_replica_takes_the_value_its_inversion_profiled(tmp_path):
     assert _profiled_by_inversion(diag, "r", inv) == (diag, "r")
     assert _profiled_by_inversion(None, "r", inv) == (None, "r")
     assert _profiled_by_inversion(diag, "r", None) == (diag, "r")
+
+
+def test_replica_closed_loop_hands_the_profiled_value_to_the_replica(tmp_path, monkeypatch):
+    """replica_closed_loop (as eroad reproduce calls it, with the invert step's folder) runs the
+    replica with the inversion's profiled value, and says so in its reason (the replica itself is
+    replaced by a recorder: what is checked is what the loop hands it)."""
+    import inverse.replica
+    from diagnosis.closed_loop import replica_closed_loop
+
+    seen = {}
+
+    def fake_replica(dataset, out, effects=None, **kw):
+        seen["effects"] = effects
+        Path(out).mkdir(parents=True)
+        (Path(out) / "config.toml").write_text('dataset = "x"\n')
+        return {"dataset": {"path": "x"}}
+    monkeypatch.setattr(inverse.replica, "run_replica", fake_replica)
+    diag = tmp_path / "diag"
+    diag.mkdir()
+    (diag / "summary.json").write_text(json.dumps(CLEAR))
+    inv = tmp_path / "invert"
+    inv.mkdir()
+    prof = {"effect": "leaf_friction", "parameter": "force", "unit": "N", "chosen": 1692.3}
+    (inv / "summary.json").write_text(json.dumps({"closed_loop": {
+        "effects": {"leaf_friction": {"force": 1692.3}}, "profile": prof}}))
+    ds = tmp_path / "ds"
+    ds.mkdir()
+    s = replica_closed_loop(ds, tmp_path / "rep", diagnosis=diag, copy_diagnosis=False, inversion=inv,
+                            progress=lambda m: None)
+    assert seen["effects"] == {"leaf_friction": {"force": 1692.3}}
+    assert s["closed_loop"]["effects"] == seen["effects"] and "profile chose" in s["closed_loop"]["reason"]
