@@ -24,6 +24,12 @@ the road: on 20 friction drives with the loop closed, the four named ``ambiguous
 errors of -0.86 to -1.53 in ln G(1 cycle/m) with the nominal model and +0.31 at most
 corrected (results/inverse_blind/20261128-correct-on-ambiguous/).
 
+The value of a named leaf friction is profiled on the inversion's own fit before it is used
+(:mod:`diagnosis.effect_profile`, since 2026-11-28, stop 50): the corrected inversion is run again
+at the value times and divided by 1.3 (up to two steps) and the run with the lowest objective is
+kept; the record (values, objectives, the choice) goes to ``closed_loop.profile``, and the replica
+of ``eroad reproduce`` reconstructs with the same value.
+
 What it is not: a diagnosis or an inversion of its own; it calls
 :func:`diagnosis.pipeline.diagnose` and :func:`inverse.run.run_inversion`, and writes::
 
