@@ -400,7 +400,7 @@ def score_run(ds: Path, scen: str, summ: dict) -> dict:
     loop = summ.get("closed_loop")
     if loop is not None:
         case["closed_loop"] = {k: loop.get(k) for k in ("verdict", "confidence", "effects", "corrected",
-                                                         "model_form", "profile")}
+                                                         "model_form")}
         if loop.get("corrected") and scen != "second_measured":
             case["nominal"] = score_case(truth, {"segments": loop["nominal_segments"]})["segments"]
     return case
@@ -462,10 +462,6 @@ def main(argv=None) -> int:
                     help="invert as `eroad invert --effects auto` does: diagnose each drive first and "
                          "invert with the effect a clear verdict names (the loop closed); the nominal "
                          "inversion of the same drive is scored beside it (`nominal` rows)")
-    ap.add_argument("--no-profile", action="store_true",
-                    help="with --effects-auto: invert at the diagnosis's value of the named effect, without "
-                         "profiling it on the inversion's fit (diagnosis.effect_profile; the loop before "
-                         "2026-11-28, stop 50)")
     ap.add_argument("--diagnoses", default=None, metavar="ROOT",
                     help="with --effects-auto: use the diagnoses of an earlier --effects-auto root "
                          "(ROOT/run-SEED/diagnose) instead of diagnosing each drive again; the diagnosis "
@@ -480,8 +476,6 @@ def main(argv=None) -> int:
         return 0
     if a.diagnoses and not a.effects_auto:
         ap.error("--diagnoses needs --effects-auto")
-    if a.no_profile and not a.effects_auto:
-        ap.error("--no-profile needs --effects-auto")
     if a.measured_every and a.scenario != "second":
         ap.error("--measured-every needs --scenario second")
     if a.measured_every < 0:
@@ -539,8 +533,7 @@ def main(argv=None) -> int:
             dg = Path(a.diagnoses) / f"run-{seed}" / "diagnose" if a.diagnoses else None
             if dg is not None and not (dg / "summary.json").is_file():
                 raise SystemExit(f"--diagnoses: no diagnosis of seed {seed} at {dg}")
-            summ = invert_closed_loop(blind, root / f"run-{seed}", progress=lambda _m: None, diagnosis=dg,
-                                      profile_value=not a.no_profile, **inv)
+            summ = invert_closed_loop(blind, root / f"run-{seed}", progress=lambda _m: None, diagnosis=dg, **inv)
         else:
             summ = run_inversion(blind, root / f"run-{seed}", **inv)
         wall = time.perf_counter() - t0

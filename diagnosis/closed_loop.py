@@ -24,12 +24,6 @@ the road: on 20 friction drives with the loop closed, the four named ``ambiguous
 errors of -0.86 to -1.53 in ln G(1 cycle/m) with the nominal model and +0.31 at most
 corrected (results/inverse_blind/20261128-correct-on-ambiguous/).
 
-The value of a named leaf friction is profiled on the inversion's own fit before it is used
-(:mod:`diagnosis.effect_profile`, since 2026-11-28, stop 50): the corrected inversion is run again
-at the value times and divided by 1.3 (up to two steps) and the run with the lowest objective is
-kept; the record (values, objectives, the choice) goes to ``closed_loop.profile``, and the replica
-of ``eroad reproduce`` reconstructs with the same value.
-
 What it is not: a diagnosis or an inversion of its own; it calls
 :func:`diagnosis.pipeline.diagnose` and :func:`inverse.run.run_inversion`, and writes::
 
@@ -308,8 +302,7 @@ def compare_table(nominal: list, corrected: list) -> pd.DataFrame:
 
 
 def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: bool = False,
-                       force: bool = False, argv=None, diagnosis=None, progress=print,
-                       profile_value: bool = True, **inversion) -> dict:
+                       force: bool = False, argv=None, diagnosis=None, progress=print, **inversion) -> dict:
     """Diagnose ``dataset``, then invert it nominal and, on a clear verdict, corrected.
 
     Parameters
@@ -321,10 +314,6 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
         An existing diagnosis run folder of this dataset to use instead of diagnosing again.
     progress : callable
         One-line progress messages.
-    profile_value : bool
-        Profile the corrected effect's value on the inversion's objective where
-        :mod:`diagnosis.effect_profile` profiles that effect (:func:`_profile_value`); False
-        inverts at the diagnosis's value alone (as before 2026-11-28, stop 50).
     **inversion
         Further keyword arguments of :func:`inverse.run.run_inversion` (not ``effects``);
         ``channels`` None or absent: chosen by the verdict (:func:`loop_channels`).
@@ -359,13 +348,6 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
                                    effects=effects, argv=argv,
                                    model_form=model_form(dsum.get("verdict"), True, singled_out(dsum)),
                                    **inversion)
-            profiled = None
-            if profile_value:
-                chosen, effects, profiled = _profile_value(dataset, work, chosen, effects, progress, run_inversion,
-                                                           dict(workers=workers, seed=seed, quick=quick, argv=argv,
-                                                                model_form=chosen["fit"]["model_form"], **inversion))
-                if profiled is not None:
-                    reason = f"{reason}; {profiled['line']}"
             main = work / "corrected"
             (work / "nominal").rename(main / "nominal")
             fq = chosen.get("fit_quality", {})
@@ -382,7 +364,6 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
         chosen["closed_loop"] = {
             "verdict": dsum.get("verdict"), "confidence": dsum.get("verdict_confidence"),
             "effects": effects or {}, "corrected": bool(effects), "reason": reason,
-            "profile": profiled if effects else None,
             "model_form": chosen.get("fit", {}).get("model_form"),
             "channel_set": chosen.get("fit", {}).get("channel_set"),
             "diagnosis": "diagnose/summary.json",
@@ -400,69 +381,6 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return chosen
-
-
-def _profile_value(dataset, work: Path, first: dict, effects: dict, progress, run_inversion,
-                   kwargs: dict) -> tuple[dict, dict, dict | None]:
-    """The corrected inversion at the value :func:`diagnosis.effect_profile.profile` chooses.
-
-    ``first`` is the inversion at the diagnosis's value (``work/corrected``); further runs go to
-    ``work/profile-N`` and the one with the lowest fit objective ends up as ``work/corrected``.
-    Returns the chosen run's summary, the effects it was inverted with, and the profile's record
-    (effect, parameter, the diagnosis's value, values and objectives tried, the chosen value, a
-    report line); the record is None where the effect is not profiled."""
-    import math
-
-    from diagnosis.effect_profile import profile, profiled_parameter
-    from vehicles.effects import EFFECTS
-
-    prof = profiled_parameter(effects)
-    if prof is None:
-        return first, effects, None
-    name, par, value, bounds = prof
-    runs = {value: (first, work / "corrected")}
-    n_feat = first["fit"]["n_features"]
-
-    def objective_at(v: float) -> float:
-        if v not in runs:
-            progress(f"closed loop: {name} {par} {v:.4g} (profiling the value on the inversion's fit) ...")
-            folder = work / f"profile-{len(runs)}"
-            runs[v] = (run_inversion(dataset, folder, effects={name: dict(effects[name], **{par: v})}, force=True,
-                                     **kwargs), folder)
-        s = runs[v][0]["fit"]
-        # the objectives compare like with like only on the same features (same segmentation)
-        return s["objective"] if s["n_features"] == n_feat else math.inf
-
-    p = profile(objective_at, value, bounds)
-    best = p["values"][p["best"]]
-    chosen, folder = runs[best]
-    for v, (_s, f) in runs.items():
-        if v != best:
-            shutil.rmtree(f, ignore_errors=True)
-    if folder != work / "corrected":
-        folder.rename(work / "corrected")
-    unit = next(q.unit for q in EFFECTS[name].parameters if q.name == par)
-    order = sorted(range(len(p["values"])), key=lambda i: p["values"][i])
-    line = (f"{name} {par} profiled on the inversion's fit objective "
-            + ", ".join(f"{p['values'][i]:.4g} {unit}: {p['objectives'][i]:.1f}" for i in order)
-            + f"; inverted at {best:.4g} {unit} (the diagnosis's value {value:.4g} {unit})")
-    record = {"effect": name, "parameter": par, "unit": unit, "diagnosis_value": value,
-              "values": p["values"], "objectives": p["objectives"], "chosen": best, "line": line}
-    return chosen, {name: dict(effects[name], **{par: best})}, record
-
-
-def _profiled_by_inversion(effects: dict | None, reason: str, inversion) -> tuple[dict | None, str]:
-    """The effects of a replica whose road comes from a closed-loop inversion (``inversion``: its
-    run folder) that profiled the same effect's value: that inversion's value, so the replica and
-    the road it reconstructs describe one vehicle; otherwise ``effects`` unchanged."""
-    if not effects or inversion is None or not (Path(inversion) / "summary.json").is_file():
-        return effects, reason
-    loop = json.loads((Path(inversion) / "summary.json").read_text()).get("closed_loop") or {}
-    prof = loop.get("profile")
-    if not prof or set(loop.get("effects") or {}) != set(effects):
-        return effects, reason
-    return loop["effects"], (f"{reason}; at the value the inversion's profile chose "
-                             f"({prof['effect']} {prof['parameter']} {prof['chosen']:.4g} {prof['unit']})")
 
 
 def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: bool = False,
@@ -487,7 +405,6 @@ def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick:
     try:
         dsum = _diagnosis_summary(dataset, work, diagnosis, copy_diagnosis, workers, quick, seed, progress, out)
         effects, reason = effects_from_diagnosis(dsum, action="reconstructed")
-        effects, reason = _profiled_by_inversion(effects, reason, replica.get("inversion"))
         progress(f"closed loop: {reason}")
         summary = run_replica(dataset, work / "replica", effects=effects, argv=argv, progress=progress, **replica)
         main = work / "replica"

@@ -3,8 +3,6 @@ the run folder it writes."""
 from __future__ import annotations
 
 import json
-import tomllib
-from pathlib import Path
 
 import pytest
 
@@ -89,16 +87,13 @@ def test_effects_on_the_vehicle_are_told_from_effects_on_road_and_channels():
     assert not on_vehicle & {"sensor", "tyre_enveloping", "speed_scale"}
 
 
-@pytest.mark.parametrize("confidence, form, profiled", [("clear", "diagnosed", True), ("ambiguous", "open", False)])
-def test_run_folder_with_a_given_diagnosis(tmp_path, confidence, form, profiled):
+@pytest.mark.parametrize("confidence, form", [("clear", "diagnosed"), ("ambiguous", "open")])
+def test_run_folder_with_a_given_diagnosis(tmp_path, confidence, form):
     """With a diagnosis that names leaf friction (given, so the test exercises the loop and not
     the diagnosis): RUN holds the corrected inversion, nominal/ and diagnose/ beside it, the
     side-by-side table, and summary.json's closed_loop; the corrected fit ran with the effect
     (config.toml) and differs from the nominal one. A 'clear' name gives the corrected fit the
-    smaller model-form term, an 'ambiguous' one (corrected too) keeps the open term. With the
-    value profiled (diagnosis.effect_profile) the run is the one with the lowest fit objective
-    among the values tried, its force is the one recorded and configured, and no profile run is
-    left behind; without, the diagnosis's value is used."""
+    smaller model-form term, an 'ambiguous' one (corrected too) keeps the open term."""
     from drives.synth import synth_command
 
     ds = tmp_path / "ds"
@@ -109,20 +104,8 @@ def test_run_folder_with_a_given_diagnosis(tmp_path, confidence, form, profiled)
     (diag / "report.md").write_text("# given\n")
     run = tmp_path / "run"
     s = invert_closed_loop(ds, run, workers=1, seed=0, diagnosis=diag, progress=lambda m: None,
-                           segments=1, max_iter=2, candidates=1, profile_value=profiled)
-    loop = s["closed_loop"]
-    if profiled:
-        prof = loop["profile"]
-        assert prof["diagnosis_value"] == 2200.0 == prof["values"][0] and len(prof["values"]) >= 3
-        assert prof["chosen"] == prof["values"][min(range(len(prof["values"])), key=prof["objectives"].__getitem__)]
-        assert s["fit"]["objective"] == min(prof["objectives"])
-        assert loop["effects"] == {"leaf_friction": {"force": prof["chosen"]}}
-        assert json.loads(tomllib.loads((run / "config.toml").read_text())["effects"]) == loop["effects"]
-        assert "profiled on the inversion's fit objective" in loop["reason"]
-        assert not [p for p in run.rglob("profile-*")]
-    else:
-        assert loop["profile"] is None and loop["effects"] == {"leaf_friction": {"force": 2200.0}}
-    assert loop["corrected"]
+                           segments=1, max_iter=2, candidates=1)
+    assert s["closed_loop"]["corrected"] and s["closed_loop"]["effects"] == {"leaf_friction": {"force": 2200.0}}
     assert s["closed_loop"]["model_form"] == form and s["fit"]["model_form"] == form
     for f in ("summary.json", "config.toml", "road.npz", "nominal/summary.json", "diagnose/report.md",
               "tables/table1_nominal_vs_corrected.md", "tables/table1.md"):
@@ -228,56 +211,3 @@ def test_a_none_verdict_fits_every_axle_with_its_own_calibration(tmp_path):
     assert fit["model_form"] == "diagnosed" and not s["closed_loop"]["corrected"]
     assert "channel set 'axles'" in s["closed_loop"]["reason"]
     assert "Fitted channels: 'axles'" in (tmp_path / "run" / "tables" / "table1.md").read_text()
-
-
-def test_a_replica_takes_the_value_its_inversion_profiled(tmp_path):
-    """eroad reproduce's replica reconstructs with the effect value the closed-loop inversion chose
-    by its profile (one vehicle for the road and its replica); an inversion without a profile, or
-    with another effect, leaves the diagnosis's value."""
-    from diagnosis.closed_loop import _profiled_by_inversion
-
-    diag = {"leaf_friction": {"force": 3065.0, "velocity": 0.01}}
-    inv = tmp_path / "invert"
-    inv.mkdir()
-    prof = {"effect": "leaf_friction", "parameter": "force", "unit": "N", "chosen": 2358.0}
-    loop = {"effects": {"leaf_friction": {"force": 2358.0, "velocity": 0.01}}, "profile": prof}
-    (inv / "summary.json").write_text(json.dumps({"closed_loop": loop}))
-    eff, why = _profiled_by_inversion(diag, "named leaf_friction", inv)
-    assert eff == loop["effects"] and "profile chose (leaf_friction force 2358 N)" in why
-    (inv / "summary.json").write_text(json.dumps({"closed_loop": dict(loop, profile=None)}))
-    assert _profiled_by_inversion(diag, "r", inv) == (diag, "r")
-    (inv / "summary.json").write_text(json.dumps({"closed_loop": dict(loop, effects={"payload": {"mass": 1.0}})}))
-    assert _profiled_by_inversion(diag, "r", inv) == (diag, "r")
-    assert _profiled_by_inversion(None, "r", inv) == (None, "r")
-    assert _profiled_by_inversion(diag, "r", None) == (diag, "r")
-
-
-def test_replica_closed_loop_hands_the_profiled_value_to_the_replica(tmp_path, monkeypatch):
-    """replica_closed_loop (as eroad reproduce calls it, with the invert step's folder) runs the
-    replica with the inversion's profiled value, and says so in its reason (the replica itself is
-    replaced by a recorder: what is checked is what the loop hands it)."""
-    import inverse.replica
-    from diagnosis.closed_loop import replica_closed_loop
-
-    seen = {}
-
-    def fake_replica(dataset, out, effects=None, **kw):
-        seen["effects"] = effects
-        Path(out).mkdir(parents=True)
-        (Path(out) / "config.toml").write_text('dataset = "x"\n')
-        return {"dataset": {"path": "x"}}
-    monkeypatch.setattr(inverse.replica, "run_replica", fake_replica)
-    diag = tmp_path / "diag"
-    diag.mkdir()
-    (diag / "summary.json").write_text(json.dumps(CLEAR))
-    inv = tmp_path / "invert"
-    inv.mkdir()
-    prof = {"effect": "leaf_friction", "parameter": "force", "unit": "N", "chosen": 1692.3}
-    (inv / "summary.json").write_text(json.dumps({"closed_loop": {
-        "effects": {"leaf_friction": {"force": 1692.3}}, "profile": prof}}))
-    ds = tmp_path / "ds"
-    ds.mkdir()
-    s = replica_closed_loop(ds, tmp_path / "rep", diagnosis=diag, copy_diagnosis=False, inversion=inv,
-                            progress=lambda m: None)
-    assert seen["effects"] == {"leaf_friction": {"force": 1692.3}}
-    assert s["closed_loop"]["effects"] == seen["effects"] and "profile chose" in s["closed_loop"]["reason"]
