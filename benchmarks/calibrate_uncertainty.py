@@ -169,18 +169,23 @@ def choose_beta(rows: list, const: dict, grid=(0.0, 0.01, 0.03, 0.05, 0.1, 0.2, 
     return out
 
 
+def smallest_holding(pools, const: dict, term: str, grid, level: float = 0.90) -> dict:
+    """Per quantity, the smallest grid value of the model-form term ``term`` (a key of ``const``,
+    e.g. "BETA_DIAGNOSED") at which ``level`` of the 90 % intervals hold in every one of ``pools``
+    (lists of rows); the last grid value if none does. The rule behind every model-form constant
+    chosen on blind drives since 2026-11-24."""
+    out = {}
+    for q in QUANTITIES:
+        out[q] = next((v for v in grid
+                       if all(coverage(rows, {**const, term: {**const.get(term, {}), q: v}})[q][0] >= level - 1e-9
+                              for rows in pools)), grid[-1])
+    return out
+
+
 def choose_beta_diagnosed(rows: list, const: dict, grid=(0.0, 0.01, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5)) -> dict:
     """Per quantity, the smallest grid value of BETA_DIAGNOSED at which 90 % of the intervals
     of ``rows`` (their "diagnosed" rows) hold; the last grid value if none does."""
-    rows = [r for r in rows if r.get("model_form") == "diagnosed"]
-    out = {}
-    for q in QUANTITIES:
-        out[q] = grid[-1]
-        for b in grid:
-            if coverage(rows, {**const, "BETA_DIAGNOSED": {**const["BETA_DIAGNOSED"], q: b}})[q][0] >= 0.90 - 1e-9:
-                out[q] = b
-                break
-    return out
+    return smallest_holding([[r for r in rows if r.get("model_form") == "diagnosed"]], const, "BETA_DIAGNOSED", grid)
 
 
 def choose_floor_diagnosed(rows: list, const: dict,
@@ -189,16 +194,7 @@ def choose_floor_diagnosed(rows: list, const: dict,
     not scale with the misfit, added to the reported sd^2 of "diagnosed" rows, BETA_DIAGNOSED kept)
     at which 90 % of the intervals of ``rows`` (their "diagnosed" rows) hold; the last grid value
     if none does."""
-    rows = [r for r in rows if r.get("model_form") == "diagnosed"]
-    out = {}
-    for q in QUANTITIES:
-        out[q] = grid[-1]
-        for f in grid:
-            trial = {**const, "FLOOR_DIAGNOSED": {**const.get("FLOOR_DIAGNOSED", {}), q: f}}
-            if coverage(rows, trial)[q][0] >= 0.90 - 1e-9:
-                out[q] = f
-                break
-    return out
+    return smallest_holding([[r for r in rows if r.get("model_form") == "diagnosed"]], const, "FLOOR_DIAGNOSED", grid)
 
 
 def coverage(rows: list, const: dict) -> dict:

@@ -22,7 +22,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / '20261128-closest-vehicle-effect'))
 from beta_unexplained import (GRID, QUANTITIES, U, calibration_sets, coverage, load,  # noqa: E402
-                              unexplained, verdicts)
+                              smallest_holding, unexplained, verdicts)
 
 #: stop 48's term, the one this script re-chose (the package ships the chosen one since)
 STOP48 = {'ln_Gq_n0': 0.05, 'w': 0.01, 'ln_G_n_best': 0.1}
@@ -40,9 +40,10 @@ def pools():
     return cal, check
 
 
-def choose(pool_list, const):
-    return {q: next((b for b in GRID if all(coverage(rows, {**const, 'BETA': {**const['BETA'], q: b}})[q][0] >= 0.9
-                                            for rows in pool_list)), GRID[-1]) for q in QUANTITIES}
+def choose(pools, const):
+    """The rule: per quantity the smallest grid value of the term (scored as BETA on the rows,
+    all relabelled 'open') at which 90 % of the intervals hold in every pool."""
+    return smallest_holding(pools, const, 'BETA', GRID)
 
 
 def cells(rows, const):
