@@ -109,8 +109,10 @@ Z90 = 1.6448536269514722
 # FLOOR_DIAGNOSED (2026-11-28, stop 49; the axle-3 fit only): the diagnosed segments of the fresh
 # friction drives (seeds 41-60) were covered 70 / 76 / 62 %, and their failing segments fit as well as
 # any (misfit ratio 0.6-1.2), so no misfit-scaled term reaches them (BETA_DIAGNOSED at 0.5 for every
-# quantity: 87 / 87 / 85 % pooled): what a corrected model leaves -- the flexible frame the loop does
-# not correct, pieces the segmentation merged -- biases the level without raising the misfit. A
+# quantity: 87 / 87 / 85 % pooled): what a corrected model leaves -- the error of the calibrated
+# effect value (stop 50: the true leaf friction instead of the diagnosis's 1318-3065 N lifted G(1) within
+# 20 % from 64.8 to 77.5 %; the truth's flexible frame added changed no segment), pieces the
+# segmentation merged -- biases the level without raising the misfit. A
 # variance added whatever the misfit, chosen by the rule of calibrate_uncertainty.choose_floor_diagnosed
 # (smallest grid value at which 90 % of the pooled diagnosed intervals hold) on the friction loops of
 # seeds 1-60 (140 segments): 0.03 / 0.01 / 0.02 (sd 0.17 / 0.10 / 0.14 in quadrature). Fresh seeds
