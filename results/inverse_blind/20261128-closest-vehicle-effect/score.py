@@ -79,6 +79,7 @@ def saved():
         pooled['after'].append(after)
     for label, ds in pooled.items():
         line(f"pooled {label}", {k: sum((d[k] for d in ds), []) for k in ds[0]})
+    return pooled['after']
 
 
 def fresh(root):
@@ -107,6 +108,7 @@ def fresh(root):
     for s in fired:
         print(f"  seed {s}: ln G(1) " + ' '.join(f"{r['lnG_1cpm_err']:+.2f}" for r in before_rows if r['seed'] == s)
               + ' -> ' + ' '.join(f"{r['lnG_1cpm_err']:+.2f}" for r in after_rows if r['seed'] == s))
+    return grouped_rows(after_rows)
 
 
 if __name__ == '__main__':

@@ -4,7 +4,7 @@ root: python results/inverse_blind/20261128-effect-profile/score_third.py [PROFI
 PROFILED: a bench_inverse.py --effects-auto run with the profile capped at two steps (worktree at 4f67d65),
 friction seeds 81-100 (records/third-81-100-profiled.jsonl by default); BASELINE: the same drives and the
 same saved diagnoses at the diagnosis's value (--no-profile --diagnoses PROFILED;
-records/third-81-100-baseline.jsonl). Truth: our own Exudyn truck with leaf friction 2000 N and a flexible
+fresh-friction-81-100/results.jsonl, the shipped loop's records). Truth: our own Exudyn truck with leaf friction 2000 N and a flexible
 frame (a gap our code made). Segments >= 3 s, drives the loop corrected (and so profiled).
 
 Adopt only if (a) on 81-100 G(1)-within-20 % gains > losses, (b) pooled over 41-60 and 81-100 (the two
@@ -43,7 +43,7 @@ def gains_losses(a, b):
 def main(argv):
     rec = HERE / 'records'
     if not argv:
-        argv = [rec / 'third-81-100-profiled.jsonl', rec / 'third-81-100-baseline.jsonl']
+        argv = [rec / 'third-81-100-profiled.jsonl', HERE / 'fresh-friction-81-100']
     prof, base = load(argv[0]), load(argv[1])
     seeds, a, b = corrected_pairs(prof, base)
     g3, l3 = gains_losses(a, b)
