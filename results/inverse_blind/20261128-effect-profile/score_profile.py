@@ -62,9 +62,15 @@ def cover(rs):
     return ' / '.join(f"{100 * cv[q][0]:.0f}" for q in QUANTITIES)
 
 
+def gains_losses(a, b):
+    """Paired segments whose G(1) within 20 % ``b`` gains over ``a``, and loses."""
+    ga, gb = g1(a), g1(b)
+    return int(np.sum(gb & ~ga)), int(np.sum(ga & ~gb))
+
+
 def paired(a, b):
     ga, gb = g1(a), g1(b)
-    gain, loss = int(np.sum(gb & ~ga)), int(np.sum(ga & ~gb))
+    gain, loss = gains_losses(a, b)
     p = binomtest(gain, gain + loss, 0.5, alternative='greater').pvalue if gain + loss else 1.0
     return (f"{len(a)} segments: G(1) within 20 % {100 * ga.mean():.1f} -> {100 * gb.mean():.1f} % "
             f"(+{gain} / -{loss}, one-sided sign test p = {p:.3f}); class {100 * klass(a).mean():.1f} -> "

@@ -13,14 +13,13 @@ drives' coverage on 81-100 stays >= 85 % in each of ln Gq(n0) / w / ln G(n_best)
 import sys
 from pathlib import Path
 
-import numpy as np
 from scipy.stats import binomtest
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parents[2] / 'benchmarks'))
 from calibrate_uncertainty import QUANTITIES, coverage  # noqa: E402
-from score_profile import g1, jsonl, paired, rows  # noqa: E402
+from score_profile import gains_losses, jsonl, paired, rows  # noqa: E402
 
 from inverse import uncertainty as U  # noqa: E402
 
@@ -30,14 +29,11 @@ def load(r):
     return {c['seed']: c for c in jsonl(r / 'results.jsonl' if r.is_dir() else r)}
 
 
-def corrected_pairs(prof, base):
-    seeds = sorted(s for s in prof if (prof[s].get('closed_loop') or {}).get('profile') and s in base)
+def corrected_pairs(prof, base, flag='profile'):
+    """The seeds whose ``prof`` record's closed loop has ``flag`` set (profiled; or 'corrected') and
+    that ``base`` holds, with both records' segment rows in that order."""
+    seeds = sorted(s for s in prof if (prof[s].get('closed_loop') or {}).get(flag) and s in base)
     return seeds, sum((rows(base[s]) for s in seeds), []), sum((rows(prof[s]) for s in seeds), [])
-
-
-def gains_losses(a, b):
-    ga, gb = g1(a), g1(b)
-    return int(np.sum(gb & ~ga)), int(np.sum(ga & ~gb))
 
 
 def main(argv):
@@ -63,9 +59,13 @@ def main(argv):
     print(f"(c) coverage >= 85 % on 81-100's corrected drives: {'yes' if ok_c else 'NO'} ("
           + ' / '.join(f"{v:.0f}" for v in cov.values()) + " %)")
     print(f"Decision by the stated test: {'ADOPT' if ok_a and ok_b and ok_c else 'NOT ADOPTED'}")
+    print(f"Whole set ({len(set(prof) & set(base))} drives, every verdict): {paired(*whole_set(prof, base))}")
+
+
+def whole_set(prof, base):
+    """Both records' segment rows over every seed the two hold."""
     allc = sorted(set(prof) & set(base))
-    print(f"Whole set ({len(allc)} drives, every verdict): "
-          f"{paired(sum((rows(base[s]) for s in allc), []), sum((rows(prof[s]) for s in allc), []))}")
+    return sum((rows(base[s]) for s in allc), []), sum((rows(prof[s]) for s in allc), [])
 
 
 if __name__ == '__main__':

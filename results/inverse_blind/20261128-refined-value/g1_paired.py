@@ -9,19 +9,16 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / '20261128-effect-profile'))
-from score_profile import paired, rows  # noqa: E402
-from score_third import load  # noqa: E402
+from score_profile import paired  # noqa: E402
+from score_third import corrected_pairs, load, whole_set  # noqa: E402
 
 
 def main():
     base = load(HERE.parent / '20261128-effect-profile' / 'fresh-friction-81-100')
     ref = load(HERE / 'refined-81-100.jsonl')
-    seeds = sorted(s for s in ref if (ref[s].get('closed_loop') or {}).get('corrected') and s in base)
-    print(f"corrected drives ({len(seeds)}): "
-          + paired(sum((rows(base[s]) for s in seeds), []), sum((rows(ref[s]) for s in seeds), [])))
-    allc = sorted(set(ref) & set(base))
-    print(f"whole set ({len(allc)} drives): "
-          + paired(sum((rows(base[s]) for s in allc), []), sum((rows(ref[s]) for s in allc), [])))
+    seeds, a, b = corrected_pairs(ref, base, flag='corrected')
+    print(f"corrected drives ({len(seeds)}): " + paired(a, b))
+    print(f"whole set ({len(set(ref) & set(base))} drives): " + paired(*whole_set(ref, base)))
 
 
 if __name__ == '__main__':

@@ -1,10 +1,9 @@
 """The leaf-friction value's error with the diagnosis's search and with the refined one (stop 51):
 python results/inverse_blind/20261128-refined-value/value_error.py  (from the repository root).
 
-The diagnosis's values are those of ../20261128-effect-profile/records/third-81-100-profiled.jsonl
-(closed_loop.profile.diagnosis_value: the value the diagnosis handed to the loop); the refined ones are
-values.jsonl here (refine_values.py 8); the diagnosis's per-fold values are in diagnosis_folds.json (copied
-from the saved diagnoses' summary.json, ranking entry leaf_friction). Truth: 2000 N (our truck, `random` scenario)."""
+The diagnosis's values, and each fold's, are in diagnosis_folds.json (copied from the saved diagnoses'
+summary.json, ranking entry leaf_friction: the value handed to the loop); the refined ones are
+values.jsonl here (refine_values.py 8). Truth: 2000 N (our truck, `random` scenario)."""
 import json
 import math
 from pathlib import Path
@@ -16,10 +15,8 @@ L = math.log(1.2)
 
 
 def main():
-    prof = [json.loads(x) for x in (HERE.parent / '20261128-effect-profile' / 'records'
-                                    / 'third-81-100-profiled.jsonl').read_text().splitlines()]
-    diag = {c['seed']: c['closed_loop']['profile']['diagnosis_value'] for c in prof
-            if (c.get('closed_loop') or {}).get('profile')}
+    dg = json.loads((HERE / 'diagnosis_folds.json').read_text())
+    diag = {int(s): d['force'] for s, d in dg.items()}
     ref = {r['seed']: r for r in map(json.loads, (HERE / 'values.jsonl').read_text().splitlines())}
     seeds = sorted(set(diag) & set(ref))
     print('| seed | diagnosis (refine 3) [N] | refined (refine 8) [N] | per fold [N] |')
@@ -35,7 +32,6 @@ def main():
     print(f"refined: the two folds' values differ by sd {fold.std():.3f} in ln; if the folds are independent, one "
           f"fold's value scatters by {fold.std() / math.sqrt(2):.3f} and their mean (the value handed on) by "
           f"{fold.std() / 2:.3f} -- against its rms error {np.sqrt(np.mean(e1 ** 2)):.3f}")
-    dg = json.loads((HERE / 'diagnosis_folds.json').read_text())
     fd = np.array([math.log(dg[str(s)]['per_fold'][0] / dg[str(s)]['per_fold'][1]) for s in seeds])
     print(f"the diagnosis's own folds (refine 3, diagnosis_folds.json, copied from the saved diagnoses): differ by "
           f"sd {fd.std():.3f} in ln; equal in {int(np.sum(np.abs(fd) < 1e-9))} of {len(fd)} (the same grid point)")
