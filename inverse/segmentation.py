@@ -694,7 +694,7 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6.2), sharex=True)
     a1.plot(time, 1e3 * np.asarray(signal), lw=0.5, color="0.3")
     a1.set_ylabel("suspension displacement [mm]")
     a2.semilogy(result.time, 1e3 * result.lrms, color="C0", lw=1.0, label="local RMS (eq 1)")
@@ -714,8 +714,14 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
             for j, tb in enumerate(np.asarray(truth_bounds)[1:-1]):
                 ax.axvline(tb, color="k", lw=0.8, ls="--", label="true boundary" if (ax is a2 and j == 0) else None)
     a2.set_ylabel(f"local RMS, {result.band[0]:g}-{result.band[1]:g} Hz [mm]")
+    # plain numbers on the log axis (less than a decade gave minor labels like "2 x 10^0");
+    # LogFormatter keeps matplotlib's choice of which minor ticks to label
+    a2.yaxis.set_major_formatter(matplotlib.ticker.LogFormatter())
+    a2.yaxis.set_minor_formatter(matplotlib.ticker.LogFormatter(labelOnlyBase=False))
     a2.set_xlabel("time [s]")
-    a2.legend(loc="lower right", fontsize=8)
+    # below the axes: inside, any corner can sit on the local RMS of some drive (the
+    # reference run's last seconds were hidden under it)
+    a2.legend(loc="upper center", bbox_to_anchor=(0.5, -0.28), ncol=2, fontsize=8, frameon=False)
     if title:
         fig.suptitle(title)
     fig.text(0.01, 0.005, "Numbers above the record: segments as numbered in Table 1 (its "
