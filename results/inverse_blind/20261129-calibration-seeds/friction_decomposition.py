@@ -10,7 +10,10 @@ with the TRUE friction (../20261128-effect-profile/records/oracle-true-friction.
 * the loop's error about the road under its own window (lnG_1cpm_err minus the window oracle's) -- the
   estimator's share, whose sd against the no-gap drives' 0.08-0.15 (docs/inverse.md, section 'Left');
 * the loop: G(1) within 20 %.
-Rows of 1-20 and 21-40 are the roots as run (before stop 48's composition that friction_sets.py applies)."""
+Rows of 1-20 and 21-40 are the roots as run (before stop 48's composition that friction_sets.py applies).
+Second table: on the drives corrected with leaf friction, the loop's error about its window's road against
+ln(value / 2000 N) of the value it was corrected with, per true class: how much of the value's error reaches
+the road, and where."""
 import json
 import math
 import sys
@@ -65,6 +68,24 @@ def main():
     loop = [r for r in load(ROOTS['seeds 61-80']) if r['seed'] in seeds]
     line(f'seeds 61-80, loop, the {len(seeds)} drives below', loop)
     line(f'seeds 61-80, the same drives at the TRUE friction', true)
+    print()
+    by_class = {}
+    for root in ROOTS.values():
+        recs = {c['seed']: c for c in map(json.loads, (root / 'results.jsonl').read_text().splitlines())}
+        for r in load(root):
+            eff = (recs[r['seed']].get('closed_loop') or {}).get('effects') or {}
+            if 'leaf_friction' in eff and r.get('oracle_fit_window'):
+                about = r['lnG_1cpm_err'] - (ln_g1(r['oracle_fit_window']['Gq'], r['oracle_fit_window']['w'])
+                                             - ln_g1(r['Gq_true'], r['w_true']))
+                by_class.setdefault(r['class_true'], []).append((math.log(eff['leaf_friction']['force'] / 2000.0), about))
+    print('| true class | segments | d(error about the window) / d ln(value): slope | correlation | sd left |')
+    print('|---|---|---|---|---|')
+    for cl in sorted(by_class):
+        x, y = np.array(by_class[cl]).T
+        if len(x) < 5:
+            continue
+        b = np.polyfit(x, y, 1)
+        print(f'| {cl} | {len(x)} | {b[0]:+.2f} | {np.corrcoef(x, y)[0, 1]:+.2f} | {np.std(y - np.polyval(b, x)):.3f} |')
 
 
 if __name__ == '__main__':
