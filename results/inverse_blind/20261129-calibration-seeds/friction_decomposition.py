@@ -13,7 +13,9 @@ with the TRUE friction (../20261128-effect-profile/records/oracle-true-friction.
 Rows of 1-20 and 21-40 are the roots as run (before stop 48's composition that friction_sets.py applies).
 Second table: on the drives corrected with leaf friction, the loop's error about its window's road against
 ln(value / 2000 N) of the value it was corrected with, per true class: how much of the value's error reaches
-the road, and where."""
+the road, and where. Third: the 90 % intervals of the corrected ('diagnosed') segments per true class, with the
+shipped constants (calibrate_uncertainty.coverage). Last line: whether a drive's share of smooth road (true
+classes A-B) tells how far its value is off."""
 import json
 import math
 import sys
@@ -25,7 +27,10 @@ HERE = Path(__file__).resolve().parent
 R = HERE.parent
 sys.path.insert(0, str(R.parents[1] / 'benchmarks'))
 sys.path.insert(0, str(R.parents[1]))
-from calibrate_uncertainty import load  # noqa: E402
+from calibrate_uncertainty import coverage, load  # noqa: E402
+from scipy.stats import spearmanr  # noqa: E402
+
+import inverse.uncertainty as U  # noqa: E402
 
 ROOTS = {'seeds 1-20': R / '20261128-correct-on-ambiguous' / 'seeds1-20',
          'seeds 21-40': R / '20261128-correct-on-ambiguous' / 'seeds21-40',
@@ -86,6 +91,31 @@ def main():
             continue
         b = np.polyfit(x, y, 1)
         print(f'| {cl} | {len(x)} | {b[0]:+.2f} | {np.corrcoef(x, y)[0, 1]:+.2f} | {np.std(y - np.polyval(b, x)):.3f} |')
+    print()
+    diag = {}
+    err, smooth = [], []
+    for root in ROOTS.values():
+        recs = {c['seed']: c for c in map(json.loads, (root / 'results.jsonl').read_text().splitlines())}
+        for r in load(root):
+            if r['model_form'] == 'diagnosed':
+                diag.setdefault(r['class_true'], []).append(r)
+        every = load(root, min_s=0.0)
+        for sd, c in recs.items():
+            eff = (c.get('closed_loop') or {}).get('effects') or {}
+            if 'leaf_friction' in eff:
+                rr = [r for r in every if r['seed'] == sd]
+                err.append(abs(math.log(eff['leaf_friction']['force'] / 2000.0)))
+                smooth.append(sum(r['duration_s'] for r in rr if r['class_true'] in 'AB') / sum(r['duration_s'] for r in rr))
+    const = U.calibration('linear')
+    print("| true class | corrected segments | 90 % intervals cover ln Gq(n0) / w / ln G(n_best) |")
+    print('|---|---|---|')
+    for cl in sorted(diag) + ['all']:
+        rows = sum(diag.values(), []) if cl == 'all' else diag[cl]
+        c = coverage(rows, const)
+        print(f"| {cl} | {len(rows)} | {' / '.join(f'{100 * c[q][0]:.0f}' for q in ('ln_Gq_n0', 'w', 'ln_G_n_best'))} % |")
+    r, p = spearmanr(smooth, err)
+    print(f'\n{len(err)} drives corrected with leaf friction: |ln(value / 2000 N)| against the share of true class A-B '
+          f'road: Spearman {r:+.2f} (p {p:.2f})')
 
 
 if __name__ == '__main__':

@@ -27,16 +27,27 @@ def arms():
     return out
 
 
-def main():
-    a = arms()
+def summary(a, only=None):
     print('| arm | drives | rms ln(value / 2000 N) | mean | median abs | within x1.2 | folds differ: sd ln | equal |')
     print('|---|---|---|---|---|---|---|---|')
     for name, v in a.items():
-        seeds = sorted(v)
+        seeds = sorted(v) if only is None else sorted(only)
+        if not set(seeds) <= set(v):
+            continue
         e = np.array([math.log(v[s][0] / 2000.0) for s in seeds])
         f = np.array([math.log(v[s][1][0] / v[s][1][1]) for s in seeds])
         print(f'| {name} | {len(seeds)} | {np.sqrt(np.mean(e ** 2)):.3f} | {e.mean():+.3f} | {np.median(np.abs(e)):.3f} '
               f'| {int(np.sum(np.abs(e) <= L))} | {f.std():.3f} | {int(np.sum(np.abs(f) < 1e-9))} |')
+
+
+def main():
+    a = arms()
+    summary(a)
+    big = [set(v) for v in a.values() if len(v) >= 8]
+    common = set.intersection(*big)
+    if any(len(b) != len(common) for b in big):
+        print(f'\nThe same {len(common)} drives in every arm of at least 8:')
+        summary(a, common)
     print()
     names = list(a)
     print('| seed | ' + ' | '.join(names) + ' |')
