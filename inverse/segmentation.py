@@ -693,6 +693,7 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6.2), sharex=True)
     a1.plot(time, 1e3 * np.asarray(signal), lw=0.5, color="0.3")
