@@ -715,10 +715,14 @@ def plot_segmentation(result: SegmentationResult, time, signal, path, title: str
             for j, tb in enumerate(np.asarray(truth_bounds)[1:-1]):
                 ax.axvline(tb, color="k", lw=0.8, ls="--", label="true boundary" if (ax is a2 and j == 0) else None)
     a2.set_ylabel(f"local RMS, {result.band[0]:g}-{result.band[1]:g} Hz [mm]")
-    # plain numbers on the log axis (less than a decade gave minor labels like "2 x 10^0");
-    # LogFormatter keeps matplotlib's choice of which minor ticks to label
-    a2.yaxis.set_major_formatter(matplotlib.ticker.LogFormatter())
-    a2.yaxis.set_minor_formatter(matplotlib.ticker.LogFormatter(labelOnlyBase=False))
+    # plain numbers on the log axis ("0.3", "2"; the default gave "2 x 10^0" and LogFormatter
+    # "3e-01"), on the ticks matplotlib's LogFormatter chooses to label
+    class PlainLog(matplotlib.ticker.LogFormatter):
+        def _num_to_string(self, x, vmin, vmax):
+            return f"{x:.3g}"
+
+    a2.yaxis.set_major_formatter(PlainLog())
+    a2.yaxis.set_minor_formatter(PlainLog(labelOnlyBase=False))
     a2.set_xlabel("time [s]")
     # below the axes: inside, any corner can sit on the local RMS of some drive (the
     # reference run's last seconds were hidden under it)
