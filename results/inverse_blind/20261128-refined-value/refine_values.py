@@ -15,20 +15,27 @@ from pathlib import Path
 from diagnosis.pipeline import diagnose
 
 
-def main(refine, seeds, data, out):
+def calibrate(settings, seeds, data, out, tag):
+    """The one candidate calibrated with ``settings`` (merged into the diagnosis's BUDGET) on each seed's blind
+    dataset; one record per seed, ``tag`` (the fields naming the settings) after the seed. Also used by
+    ../20261129-calibration-seeds/calibrate_values.py."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     for s in seeds:
         t = time.perf_counter()
         d = diagnose(Path(data) / f'blind-random-{s}', out / f'run-{s}', effects=['leaf_friction'],
-                     settings={'refine': refine}, force=True, progress=lambda m: None)
+                     settings=settings, force=True, progress=lambda m: None)
         r = next(x for x in d['ranking'] if x['effect'] == 'leaf_friction')
-        rec = {'seed': s, 'refine': refine, 'force': r['parameters']['leaf_friction']['force'],
+        rec = {'seed': s, **tag, 'force': r['parameters']['leaf_friction']['force'],
                'per_fold': [p['leaf_friction']['force'] for p in r['parameters_per_fold']],
                'n_evaluations': r['n_evaluations'], 'wall_s': time.perf_counter() - t}
         print(json.dumps(rec), flush=True)
         with open(out / 'values.jsonl', 'a') as f:
             f.write(json.dumps(rec) + '\n')
+
+
+def main(refine, seeds, data, out):
+    calibrate({'refine': refine}, seeds, data, out, {'refine': refine})
 
 
 if __name__ == '__main__':

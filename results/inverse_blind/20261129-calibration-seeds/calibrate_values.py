@@ -9,26 +9,15 @@ seed and values.jsonl (the calibrated force, per fold, evaluations, wall). Only 
 the diagnosis's own calibration of it with the settings changed."""
 import json
 import sys
-import time
 from pathlib import Path
 
-from diagnosis.pipeline import diagnose
+# the loop is stop 51's (refine_values.calibrate), with any settings instead of refine alone
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / '20261128-refined-value'))
+from refine_values import calibrate  # noqa: E402
 
 
 def main(settings, seeds, data, out):
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    for s in seeds:
-        t = time.perf_counter()
-        d = diagnose(Path(data) / f'blind-random-{s}', out / f'run-{s}', effects=['leaf_friction'],
-                     settings=settings, force=True, progress=lambda m: None)
-        r = next(x for x in d['ranking'] if x['effect'] == 'leaf_friction')
-        rec = {'seed': s, 'settings': settings, 'force': r['parameters']['leaf_friction']['force'],
-               'per_fold': [p['leaf_friction']['force'] for p in r['parameters_per_fold']],
-               'n_evaluations': r['n_evaluations'], 'wall_s': time.perf_counter() - t}
-        print(json.dumps(rec), flush=True)
-        with open(out / 'values.jsonl', 'a') as f:
-            f.write(json.dumps(rec) + '\n')
+    calibrate(settings, seeds, data, out, {'settings': settings})
 
 
 if __name__ == '__main__':

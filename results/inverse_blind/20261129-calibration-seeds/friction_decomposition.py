@@ -46,6 +46,11 @@ def ln_g1(gq, w):
     return math.log(gq) - w * math.log(10.0)
 
 
+def window_error(r):
+    """ln G(1) of the road fitted over the row's fitted window (the window oracle) against the truth's."""
+    return ln_g1(r['oracle_fit_window']['Gq'], r['oracle_fit_window']['w']) - ln_g1(r['Gq_true'], r['w_true'])
+
+
 def line(label, rows):
     within = lambda e: float(np.mean(np.abs(e) <= L))
     e = np.array([r['lnG_1cpm_err'] for r in rows])
@@ -54,7 +59,7 @@ def line(label, rows):
         return
     tru = [ln_g1(r['Gq_true'], r['w_true']) for r in rows]
     ot = np.array([ln_g1(r['oracle']['Gq'], r['oracle']['w']) - t for r, t in zip(rows, tru)])
-    ow = np.array([ln_g1(r['oracle_fit_window']['Gq'], r['oracle_fit_window']['w']) - t for r, t in zip(rows, tru)])
+    ow = np.array([window_error(r) for r in rows])
     about = e - ow
     print(f"| {label} | {len(rows)} | {100 * within(ot):.0f} % | {100 * within(ow):.0f} % | {about.mean():+.3f} / "
           f"{about.std():.3f} / {np.median(np.abs(about)):.3f} | {100 * within(e):.1f} % |")
@@ -74,15 +79,24 @@ def main():
     line(f'seeds 61-80, loop, the {len(seeds)} drives below', loop)
     line(f'seeds 61-80, the same drives at the TRUE friction', true)
     print()
-    by_class = {}
+    # one pass over the five sets: the drives corrected with leaf friction, per true class
+    by_class, diag, err, smooth = {}, {}, [], []
     for root in ROOTS.values():
         recs = {c['seed']: c for c in map(json.loads, (root / 'results.jsonl').read_text().splitlines())}
+        value = {sd: ((c.get('closed_loop') or {}).get('effects') or {}).get('leaf_friction', {}).get('force')
+                 for sd, c in recs.items()}
         for r in load(root):
-            eff = (recs[r['seed']].get('closed_loop') or {}).get('effects') or {}
-            if 'leaf_friction' in eff and r.get('oracle_fit_window'):
-                about = r['lnG_1cpm_err'] - (ln_g1(r['oracle_fit_window']['Gq'], r['oracle_fit_window']['w'])
-                                             - ln_g1(r['Gq_true'], r['w_true']))
-                by_class.setdefault(r['class_true'], []).append((math.log(eff['leaf_friction']['force'] / 2000.0), about))
+            if value[r['seed']] and r.get('oracle_fit_window'):
+                by_class.setdefault(r['class_true'], []).append(
+                    (math.log(value[r['seed']] / 2000.0), r['lnG_1cpm_err'] - window_error(r)))
+            if r['model_form'] == 'diagnosed':
+                diag.setdefault(r['class_true'], []).append(r)
+        every = load(root, min_s=0.0)
+        for sd in recs:
+            if value[sd]:
+                rr = [r for r in every if r['seed'] == sd]
+                err.append(abs(math.log(value[sd] / 2000.0)))
+                smooth.append(sum(r['duration_s'] for r in rr if r['class_true'] in 'AB') / sum(r['duration_s'] for r in rr))
     print('| true class | segments | d(error about the window) / d ln(value): slope | correlation | sd left |')
     print('|---|---|---|---|---|')
     for cl in sorted(by_class):
@@ -92,20 +106,6 @@ def main():
         b = np.polyfit(x, y, 1)
         print(f'| {cl} | {len(x)} | {b[0]:+.2f} | {np.corrcoef(x, y)[0, 1]:+.2f} | {np.std(y - np.polyval(b, x)):.3f} |')
     print()
-    diag = {}
-    err, smooth = [], []
-    for root in ROOTS.values():
-        recs = {c['seed']: c for c in map(json.loads, (root / 'results.jsonl').read_text().splitlines())}
-        for r in load(root):
-            if r['model_form'] == 'diagnosed':
-                diag.setdefault(r['class_true'], []).append(r)
-        every = load(root, min_s=0.0)
-        for sd, c in recs.items():
-            eff = (c.get('closed_loop') or {}).get('effects') or {}
-            if 'leaf_friction' in eff:
-                rr = [r for r in every if r['seed'] == sd]
-                err.append(abs(math.log(eff['leaf_friction']['force'] / 2000.0)))
-                smooth.append(sum(r['duration_s'] for r in rr if r['class_true'] in 'AB') / sum(r['duration_s'] for r in rr))
     const = U.calibration('linear')
     print("| true class | corrected segments | 90 % intervals cover ln Gq(n0) / w / ln G(n_best) |")
     print('|---|---|---|')
