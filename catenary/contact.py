@@ -16,6 +16,13 @@ penalty the update is exact and needs no iteration: the contact is active in the
 if and only if the penetration of the contact-free prediction is positive, and the
 contact force is ``k_c`` times the penetration, zero otherwise.
 
+Friction (optional, :attr:`Collector.friction`): a Coulomb force between one collector
+DOF and the base, solved in the same step without regularisation.  The step's solution
+is linear in the friction force ``F`` and so is the DOF's end-of-step velocity relative
+to the base; ``F`` is the one value that obeys Coulomb's law there: the DOF sticks
+(relative velocity 0) if that takes ``|F| <= friction``, else it slips with
+``F = -friction sign(v_rel)``.  Contact and slack droppers are re-checked with ``F`` in.
+
 Sign conventions: z up [m], displacements about the static equilibrium under gravity;
 contact force [N] positive when the collector pushes the wire up.
 
@@ -59,6 +66,13 @@ class Collector:
         Coupling to the base displacement [N/m] and velocity [N s/m].
     labels : tuple of str
         DOF names.
+    friction : float
+        Coulomb friction force [N] between DOF ``friction_dof`` and the base (the frame
+        joints' friction, EN 50318's lumped pantograph lists it); 0: none.  It acts
+        against the DOF's velocity relative to the base's, with sticking: while the force
+        needed to hold the DOF at the base's velocity is below ``friction`` the DOF sticks.
+    friction_dof : int
+        The DOF the friction acts on (default -1: the last, the frame on the base).
     """
 
     M: np.ndarray
@@ -69,6 +83,8 @@ class Collector:
     base_k: np.ndarray
     base_c: np.ndarray
     labels: tuple[str, ...] = ()
+    friction: float = 0.0
+    friction_dof: int = -1
 
     @property
     def n(self) -> int:
@@ -84,7 +100,8 @@ class ContactResult:
     [N], ``head_z`` collector contact DOF [m], ``wire_z`` contact wire height at the
     contact point (profile + displacement) [m], ``uplift`` contact wire displacement at
     the contact point [m], ``base_z`` [m], ``collector`` all collector DOFs [m],
-    ``pole_uplift`` contact wire displacement at the poles [m] (N, n_poles).
+    ``pole_uplift`` contact wire displacement at the poles [m] (N, n_poles), ``friction``
+    the collector's friction force on its friction DOF [N] (0 without friction).
     """
 
     time: np.ndarray
@@ -340,6 +357,15 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
     fs = np.asarray(collector.f_static, dtype=float)
     bk = np.asarray(collector.base_k, dtype=float)
     bc = np.asarray(collector.base_c, dtype=float)
+    fr = float(collector.friction)
+    if not (math.isfinite(fr) and fr >= 0.0):
+        raise EroadInputError(f"collector friction must be a finite force >= 0 N, got {fr}")
+    fdof = None
+    if fr > 0.0:
+        jf = int(collector.friction_dof)
+        if not -m <= jf < m:
+            raise EroadInputError(f"collector friction_dof {jf} is not one of its {m} DOFs")
+        fdof = nl + jf % m
 
     def f_ext(k: int) -> np.ndarray:
         f = np.zeros(N)
@@ -415,6 +441,14 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
     st = _HHT(M, C, K, dt, alpha)
     al = st.a
     kp = (1.0 + al) * kc
+    if fdof is not None:
+        # friction force F on fdof (its reaction goes into the prescribed base): it enters
+        # the step as (1 + alpha) F e_f, so q1 = q1(F=0) + F z; the end-of-step velocity
+        # is linear in F, and F is the one Coulomb value that is consistent (stick: the
+        # relative velocity ends at 0 with |F| <= friction; slip: F = -friction sign(v))
+        ef = np.zeros(N); ef[fdof] = 1.0
+        yfr = (1.0 + al) * st.lu.solve(ef)
+        dv_dq = st.gamma / (st.beta * dt)
     ydrop: dict[int, np.ndarray] = {}
 
     def ydrop_of(j: int) -> np.ndarray:
@@ -442,11 +476,13 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
     nr = rec.size
     force = np.zeros(nr); headz = np.zeros(nr); uplift = np.zeros(nr); wire = np.zeros(nr)
     nslack = np.zeros(nr, dtype=np.int16)
+    fric = np.zeros(nr)
+    ffr = 0.0
     coll = np.zeros((nr, m))
     poles = line.wire_dofs("contact")[line.pole_nodes] if line.pole_nodes.size else np.zeros(0, int)
     pole_up = np.zeros((nr, poles.size))
 
-    def store(j, k, q, fcon, ns):
+    def store(j, k, q, fcon, ns, ff=0.0):
         idx, w = line.shape(xs[k])
         force[j] = fcon
         headz[j] = q[head]
@@ -454,6 +490,7 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
         wire[j] = uplift[j] + line.profile(xs[k])
         coll[j] = q[nl:]
         nslack[j] = ns
+        fric[j] = ff
         if poles.size:
             pole_up[j] = np.where(poles >= 0, q[np.maximum(poles, 0)], 0.0)
 
@@ -496,6 +533,17 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
                 q1 = y - Y @ np.linalg.solve(Dinv + UtY, Uty)
             else:
                 q1 = yb
+            if fdof is not None:
+                z = yfr
+                if cols:
+                    uf = np.array([cu[1] @ yfr[cu[0]] for cu in cols])
+                    z = yfr - Y @ np.linalg.solve(Dinv + UtY, uf)
+                a1f = ((q1[fdof] - q[fdof] - dt * v[fdof]) / (st.beta * dt * dt)
+                       - (0.5 / st.beta - 1.0) * a[fdof])
+                vrel = v[fdof] + dt * ((1.0 - st.gamma) * a[fdof] + st.gamma * a1f) - zbd[k]
+                s_f = dv_dq * float(z[fdof])
+                ffr = -vrel / s_f if abs(vrel) <= fr * s_f else -fr * math.copysign(1.0, vrel)
+                q1 = q1 + ffr * z
             p1 = float(hw @ q1[hi]) - y0
             on_new, S_new = p1 > 0.0, slack_set(q1)
             if on_new == on_k and S_new == S_k:
@@ -507,10 +555,12 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
         on, S = on_k, S_k
         fcon = kc * p1 if on else 0.0
         fnl1 = -fcon * hvec + dropper_force(q1, S)
+        if fdof is not None:
+            fnl1[fdof] += ffr
         v, a = st.finish(q1, q, v, a)
         q, f0, fnl0 = q1, f1, fnl1
         if j < nr and rec[j] == k:
-            store(j, k, q, max(fcon, 0.0), len(S))
+            store(j, k, q, max(fcon, 0.0), len(S), ffr)
             j += 1
         if k % every == 0:
             if not np.isfinite(q[head]):
@@ -519,11 +569,13 @@ def simulate_contact(line: ContactLine, collector: Collector, *, speed: float,
                 progress(k / n_steps)
     tr = t[rec]
     ch = {"x": xs[rec], "force": force, "head_z": headz, "uplift": uplift, "wire_z": wire,
-          "base_z": zb[rec], "collector": coll, "pole_uplift": pole_up, "n_slack": nslack}
+          "base_z": zb[rec], "collector": coll, "pole_uplift": pole_up, "n_slack": nslack,
+          "friction": fric}
     units = {"time": "s", "x": "m", "force": "N", "head_z": "m", "uplift": "m", "wire_z": "m",
-             "base_z": "m", "collector": "m", "pole_uplift": "m", "n_slack": "-"}
+             "base_z": "m", "collector": "m", "pole_uplift": "m", "n_slack": "-",
+             "friction": "N"}
     meta = {"dt": dt, "alpha": alpha, "contact_stiffness": kc, "speed": speed,
             "x_start": x_start, "x_end": x_end, "n_dof": N, "line": line.params.name,
             "collector_labels": ",".join(collector.labels), "dropper_slack": slack_on,
-            "active_set_unconverged_steps": n_unconverged}
+            "active_set_unconverged_steps": n_unconverged, "friction": fr}
     return ContactResult(tr, ch, units, meta)

@@ -4,17 +4,32 @@ from __future__ import annotations
 import argparse
 import math
 
-__all__ = ["positive_float", "nonnegative_int"]
+__all__ = ["positive_float", "nonnegative_float", "nonnegative_int"]
 
 
-def positive_float(text: str) -> float:
-    """A finite number > 0, else argparse's one-line error."""
+def _finite(text: str) -> float:
     try:
         v = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not (math.isfinite(v) and v > 0):
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return v
+
+
+def positive_float(text: str) -> float:
+    """A finite number > 0, else argparse's one-line error."""
+    v = _finite(text)
+    if not v > 0:
         raise argparse.ArgumentTypeError(f"{text!r} must be positive")
+    return v
+
+
+def nonnegative_float(text: str) -> float:
+    """A finite number >= 0, else argparse's one-line error."""
+    v = _finite(text)
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be >= 0")
     return v
 
 

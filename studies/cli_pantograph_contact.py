@@ -23,7 +23,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from eroad.argtypes import nonnegative_int, positive_float
+from eroad.argtypes import nonnegative_float, nonnegative_int, positive_float
 
 __all__ = ["register"]
 
@@ -56,7 +56,8 @@ def _mounts(text: str) -> tuple:
 #: the options that shape a drive (``--road``) and their defaults: given without a road (the
 #: railway reference alone) they would be ignored, so they are refused there
 DRIVE_ONLY = {"speed_kmh": 80.0, "duration": 30.0, "line": "truck_ohl", "pantograph": "truck",
-              "chassis": "flexible", "frame_factor": 1.0, "mount_factor": 1.0, "dt": 1e-3}
+              "chassis": "flexible", "frame_factor": 1.0, "mount_factor": 1.0, "dt": 1e-3,
+              "frame_friction": None}
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -86,6 +87,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="frame stiffness factor [-] (default 1)")
     p.add_argument("--mount-factor", type=_positive, default=DRIVE_ONLY["mount_factor"],
                    help="DCDC mount stiffness factor [-] (default 1)")
+    p.add_argument("--frame-friction", type=nonnegative_float, default=None, metavar="N",
+                   help="Coulomb friction of the pantograph's frame joints [N] (default: the "
+                   "pantograph file's, 0 in the built-in files)")
     p.add_argument("--dt", type=_positive, default=DRIVE_ONLY["dt"], help="contact time step [s] (default 1e-3)")
     p.add_argument("--no-compare", action="store_true",
                    help="skip the run with the pantograph base at rest")
@@ -167,7 +171,8 @@ def _run(args: argparse.Namespace) -> int:
         kw = dict(speed_kmh=args.speed_kmh, duration=args.duration, line=args.line,
                   pantograph=args.pantograph, chassis=args.chassis,
                   frame_factor=args.frame_factor, mount_factor=args.mount_factor,
-                  dt=args.dt, compare_static=not args.no_compare)
+                  dt=args.dt, compare_static=not args.no_compare,
+                  frame_friction=args.frame_friction)
     s = run_pantograph_contact(args.road, args.out, reference=args.railway_reference,
                                command=sys.argv, **kw)
     if args.json:

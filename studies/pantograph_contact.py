@@ -122,7 +122,8 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
                   chassis: str = "flexible", frame_factor: float = 1.0,
                   mount_factor: float = 1.0, dt: float = 1e-3, t_skip: float = 1.0,
                   compare_static: bool = True, lowpass_hz: float = 20.0,
-                  base_scale: float = 1.0) -> dict[str, Any]:
+                  base_scale: float = 1.0,
+                  frame_friction: float | None = None) -> dict[str, Any]:
     """Drive, base motion, pantograph-contact simulation and statistics.
 
     Parameters
@@ -149,6 +150,9 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
         Factor on the base motion fed to the pantograph (vertical and lateral; default
         1).  0 holds the base still on the same line, speed, travel and time grid as the
         drive (the reference of :mod:`studies.pantograph_chassis`).
+    frame_friction : float, optional
+        Coulomb friction of the pantograph's frame joints [N], replacing the file's
+        ``frame_friction`` (default: the file's, 0 in the built-in files).
 
     Returns
     -------
@@ -170,6 +174,11 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
     if not (math.isfinite(base_scale) and base_scale >= 0):
         raise EroadInputError(f"base_scale must be a finite number >= 0, got {base_scale}")
     pp = load_pantograph(pantograph)
+    if frame_friction is not None:
+        if not (math.isfinite(frame_friction) and frame_friction >= 0):
+            raise EroadInputError(f"frame friction must be a finite force >= 0 N, got "
+                                  f"{frame_friction}")
+        pp = replace(pp, frame_friction=float(frame_friction))
     v = speed_kmh / 3.6
     vp = tractor_variant(DEFAULT_VEHICLE, mount_factor)
     # whole seconds, at least half a second short of the road's end: with t_max - 0.5
@@ -218,6 +227,7 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
             "tractor": tractor_range(lift_pct, tyres),
             "config": {"speed_kmh": float(speed_kmh), "duration_s": dur, "dt_s": dt,
                        "line": str(line), "pantograph": str(pp.name),
+                       "frame_friction_N": pp.frame_friction,
                        "n_spans": cl.params.n_spans, "n_dof": int(res.meta["n_dof"]),
                        "base_z_rms_m": float(base_scale * np.std(m.Tz)),
                        "base_scale": float(base_scale),

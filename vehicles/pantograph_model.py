@@ -15,9 +15,12 @@ What it is for: the pantograph that stands on the e-tractor's DCDC block, as
 Parameters are TOML files in ``vehicles/data/pantograph_*.toml`` with a ``[sources]``
 table giving the origin of each number.
 
-What it is not: friction in the frame joints (EN 50318 lists it; the implicit linear
-contact solver here has no place for it, so it is left out and said so), aerodynamic
-uplift, a flexible collector strip, active lateral positioning of the head, or the
+Friction in the frame joints (EN 50318 lists it) is ``frame_friction``: a Coulomb force
+between the frame DOF that stands on the base and the base, solved with sticking by
+:func:`catenary.contact.simulate_contact`.  It is optional in the TOML (0 when absent) and
+0 in the built-in files, which have no sourced value for it.
+
+What it is not: aerodynamic uplift, a flexible collector strip, active lateral positioning of the head, or the
 contact line (:mod:`catenary`).
 """
 from __future__ import annotations
@@ -44,7 +47,8 @@ def _f(unit: str, doc: str):
 
 @dataclass(frozen=True)
 class PantographParams:
-    """Three-mass pantograph with a lateral head DOF (all fields required)."""
+    """Three-mass pantograph with a lateral head DOF (all fields required except
+    ``frame_friction``)."""
 
     name: str = _f("-", "label")
     head_mass: float = _f("kg", "m1, pan head (collector strips)")
@@ -64,6 +68,9 @@ class PantographParams:
     head_half_width: float = _f("m", "usable half-width of the collector strip")
     head_height: float = _f("m", "working height of the contact point above the base")
     sources: tuple[tuple[str, str], ...] = _f("-", "field -> where the number comes from")
+    frame_friction: float = field(default=0.0, metadata={
+        "unit": "N", "doc": "Coulomb friction of the frame joints, between the frame DOF on "
+        "the base (the lower frame; the frame of a two-mass model) and the base; 0: none"})
 
     def validate(self, where: str = "pantograph") -> None:
         """Refuse impossible values, naming the field."""
@@ -89,6 +96,10 @@ def pantograph_ids() -> list[str]:
     return sorted(p.stem[len("pantograph_"):] for p in DATA_DIR.glob("pantograph_*.toml"))
 
 
+#: fields a pantograph file may leave out (their dataclass default applies)
+_OPTIONAL = ("frame_friction",)
+
+
 def load_pantograph(name_or_path: str | Path) -> PantographParams:
     """Load a pantograph from a built-in id or a TOML file.
 
@@ -110,6 +121,8 @@ def load_pantograph(name_or_path: str | Path) -> PantographParams:
     kw = {}
     for name in names:
         if name not in data:
+            if name in _OPTIONAL:
+                continue
             raise EroadInputError(f"{p}: missing key '{name}'")
         v = data[name]
         if name == "name":
@@ -148,9 +161,10 @@ def collector(pp: PantographParams, static_force: float | None = None) -> Collec
     """The vertical three-mass chain as a :class:`catenary.contact.Collector`.
 
     DOFs ``(head, upper, lower)``, z up [m]; the contact DOF is the head; the base drives
-    the lower frame through ``k3, c3``; the static force acts on the lower frame.  With
-    ``lower_mass = 0`` (two-mass model) the DOFs are ``(head, frame)``, the base drives
-    the frame through ``k2, c2`` and the static force acts on the frame.
+    the lower frame through ``k3, c3``; the static force and the frame friction act on the
+    lower frame.  With ``lower_mass = 0`` (two-mass model) the DOFs are ``(head, frame)``,
+    the base drives the frame through ``k2, c2`` and the static force and friction act on
+    the frame.
 
     Parameters
     ----------
@@ -163,11 +177,13 @@ def collector(pp: PantographParams, static_force: float | None = None) -> Collec
     if pp.lower_mass == 0.0:
         return Collector(M=M, C=C, K=K, head=0, f_static=np.array([0.0, F0]),
                          base_k=np.array([0.0, pp.upper_stiffness]),
-                         base_c=np.array([0.0, pp.upper_damping]), labels=("head", "frame"))
+                         base_c=np.array([0.0, pp.upper_damping]), labels=("head", "frame"),
+                         friction=pp.frame_friction, friction_dof=-1)
     return Collector(M=M, C=C, K=K, head=0, f_static=np.array([0.0, 0.0, F0]),
                      base_k=np.array([0.0, 0.0, pp.lower_stiffness]),
                      base_c=np.array([0.0, 0.0, pp.lower_damping]),
-                     labels=("head", "upper", "lower"))
+                     labels=("head", "upper", "lower"), friction=pp.frame_friction,
+                     friction_dof=-1)
 
 
 def vertical_modes(pp: PantographParams, contact_stiffness: float = 0.0) -> np.ndarray:
