@@ -43,7 +43,7 @@ def one(road, friction: float, speed_kmh: float) -> dict:
 
 def table(rows: dict) -> str:
     head = ("| road | friction [N] | sd drive [N] | sd base at rest [N] | sd added by the base "
-            "[N] | min / max drive [N] | loss drive [%] | frame stuck, drive / at rest [%] |")
+            "[N] | min / max drive, 20 Hz low-pass [N] | loss drive [%] | frame stuck, drive / at rest [%] |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for name, rs in rows.items():
         for r in rs:
@@ -69,11 +69,10 @@ def plot(rows: dict, path: Path) -> None:
         axs[0].plot(f, [r["drive"]["sd"] for r in rs], "o-", color=col, label=f"{name}: base moved")
         axs[0].plot(f, [r["base_at_rest"]["sd"] for r in rs], "s--", color=col, alpha=0.7,
                     label=f"{name}: base at rest")
-        axs[1].plot(f, [r["drive"]["actual_min"] for r in rs], "o-", color=col, label=name)
+        axs[1].plot(f, [r["drive"]["loss_percent"] for r in rs], "o-", color=col, label=name)
         axs[2].plot(f[1:], [100 * r["stuck_share"] for r in rs[1:]], "o-", color=col, label=name)
     axs[0].set_ylabel("contact force sd [N] (20 Hz low-pass)")
-    axs[1].set_ylabel("smallest contact force in the drive [N]")
-    axs[1].axhline(0.0, color="k", lw=0.6)
+    axs[1].set_ylabel("contact loss in the drive, base moved [%]")
     axs[2].set_ylabel("samples with the frame stuck to the base [%]")
     axs[2].set_ylim(0, 100)
     for ax in axs:

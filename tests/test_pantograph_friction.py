@@ -161,3 +161,34 @@ def test_cli_refuses_negative_friction_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert "--frame-friction" in err[-1] and "must be >= 0" in err[-1]
     assert not any(tmp_path.iterdir())
+
+
+def test_friction_beyond_any_load_welds_the_frame_to_the_base(short_line):
+    """A friction no force in the run can overcome holds the lower frame on the base: the
+    three-mass pantograph then is the two-mass chain (head, upper frame) whose upper frame
+    stands on the base through k2, c2 with the lower frame's start height as preload.
+    Both run on the same line under the same base motion (5 mm at 3 Hz, from rest); their contact
+    forces agree to 1e-3 of the force's own sd (the stuck frame follows the trapezoidal
+    integral of the base velocity, which differs from the base height by O(dt^2))."""
+    pp = replace(load_pantograph("truck"), frame_friction=1.0e7)
+    dt, v, dur = 1e-3, 20.0, 3.0
+    n = int(math.floor(dur / dt + 1e-9)) + 1
+    t = dt * np.arange(n)
+    w = 2 * math.pi * 3.0
+    # from rest: the start is static, so a base already moving at t = 0 would offset the
+    # frame by dt/2 times that velocity in the first step
+    zb, zbd = 0.005 * (1.0 - np.cos(w * t)), 0.005 * w * np.sin(w * t)
+    kw = dict(speed=v, x_start=40.0, x_end=40.0 + v * dur, dt=dt, base_z=zb, base_zdot=zbd)
+    stuck = simulate_contact(short_line, collector(pp), **kw)
+    assert np.all(np.abs(stuck["friction"]) < 1.0e7)  # never slipped
+    z3 = stuck["collector"][:, 2]
+    assert np.ptp(z3 - zb) < 1e-6
+    k1, k2, c1, c2 = pp.head_stiffness, pp.upper_stiffness, pp.head_damping, pp.upper_damping
+    two = Collector(M=np.diag([pp.head_mass, pp.upper_mass]),
+                    C=np.array([[c1, -c1], [-c1, c1 + c2]]),
+                    K=np.array([[k1, -k1], [-k1, k1 + k2]]), head=0,
+                    f_static=np.array([0.0, k2 * z3[0]]), base_k=np.array([0.0, k2]),
+                    base_c=np.array([0.0, c2]))
+    ref = simulate_contact(short_line, two, **kw)
+    assert np.std(ref["force"]) > 5.0  # the base motion does drive the chain
+    assert np.max(np.abs(stuck["force"] - ref["force"])) < 1e-3 * np.std(ref["force"])
