@@ -18,6 +18,10 @@ vehicles.pantograph_model PantographParams.frame_friction) against closed forms.
    moving head adds the rest.
 3. Friction zero leaves the run identical to a collector without the field (the code
    path is skipped), and a negative or non-finite friction is refused with one line.
+4. Friction no load overcomes welds the DOF to the base: the three-mass pantograph then
+   is the two-mass chain on the base (another model, same line), and a contact DOF held
+   by friction pushes the line as one held by a stiff spring does (this one checks the
+   contact's column in the friction solve; tolerances in each test).
 """
 import math
 from dataclasses import replace
@@ -192,3 +196,34 @@ def test_friction_beyond_any_load_welds_the_frame_to_the_base(short_line):
     ref = simulate_contact(short_line, two, **kw)
     assert np.std(ref["force"]) > 5.0  # the base motion does drive the chain
     assert np.max(np.abs(stuck["force"] - ref["force"])) < 1e-3 * np.std(ref["force"])
+
+
+def test_welded_contact_dof_matches_a_stiff_spring_weld(short_line):
+    """Friction on the contact DOF itself, beyond any load, holds the head on the base
+    while it pushes the line (a stiff 1e6 N/m contact, so the contact's own column
+    matters in the friction solve).  Reference: the same head held on the base by a
+    1e9 N/m spring with the preload that starts it at the same height, no friction.  The
+    spring lets the head move by (force change) / 1e9 ~ 2e-7 m, which the contact turns
+    into ~0.2 N, and contact opens and closes in this run (min force 0); tolerance 3 %
+    of the force's sd (40 N)."""
+    dt, v, dur = 1e-3, 20.0, 3.0
+    n = int(math.floor(dur / dt + 1e-9)) + 1
+    t = dt * np.arange(n)
+    w = 2 * math.pi * 3.0
+    zb, zbd = 0.005 * (1.0 - np.cos(w * t)), 0.005 * w * np.sin(w * t)
+    kw = dict(speed=v, x_start=40.0, x_end=40.0 + v * dur, dt=dt, base_z=zb, base_zdot=zbd,
+              contact_stiffness=1.0e6)
+    held = Collector(M=np.array([[1.0]]), C=np.zeros((1, 1)), K=np.array([[100.0]]), head=0,
+                     f_static=np.array([70.0]), base_k=np.array([100.0]), base_c=np.zeros(1),
+                     friction=1.0e6, friction_dof=0)
+    r = simulate_contact(short_line, held, **kw)
+    z = r["collector"][:, 0]
+    assert np.ptp(z - zb) < 1e-6
+    kw_ = 1.0e9
+    spring = Collector(M=np.array([[1.0]]), C=np.zeros((1, 1)), K=np.array([[100.0 + kw_]]),
+                       head=0, f_static=np.array([70.0 + kw_ * z[0]]),
+                       base_k=np.array([100.0 + kw_]), base_c=np.zeros(1))
+    ref = simulate_contact(short_line, spring, **kw)
+    sd = np.std(ref["force"])
+    assert sd > 20.0 and ref["force"].min() == 0.0
+    assert np.max(np.abs(r["force"] - ref["force"])) < 0.03 * sd
