@@ -179,6 +179,8 @@ def _run(args: argparse.Namespace) -> int:
         print(json.dumps(s, indent=2, default=str))
         return 0
     if "contact" in s:
+        cfg = s["config"]
+        print(f"pantograph: {cfg['pantograph']}, frame friction {cfg['frame_friction_N']:g} N")
         print(f"contact force (drive):      {_fmt(s['contact'])}")
         if s.get("contact_base_at_rest"):
             print(f"contact force (base still): {_fmt(s['contact_base_at_rest'])}")
