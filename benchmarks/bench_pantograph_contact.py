@@ -11,13 +11,15 @@ road speeds, so two contact cases are timed:
   each from the static start) to fill the drive's duration;
 * ``full``: the line as long as the drive (what ``eroad pantograph-contact`` builds).
 
-Prints wall times and the ratios to the tractor-alone simulation.  Timings are for
-looking at, never a pass/fail test.
+Prints wall times and the ratios to the tractor-alone simulation, and the full line once
+more with frame friction in the pantograph (``--frame-friction``, default 20 N; the base
+driven by the same random walk), against the run without.  Timings are for looking at,
+never a pass/fail test.
 
 Usage::
 
     nice python benchmarks/bench_pantograph_contact.py --road ROAD.npz [--speed-kmh 80]
-        [--duration 30] [--dt 1e-3]
+        [--duration 30] [--dt 1e-3] [--frame-friction 20]
 """
 from __future__ import annotations
 
@@ -35,6 +37,7 @@ def main() -> None:
     ap.add_argument("--speed-kmh", type=float, default=80.0)
     ap.add_argument("--duration", type=float, default=30.0)
     ap.add_argument("--dt", type=float, default=1e-3)
+    ap.add_argument("--frame-friction", type=float, default=20.0)
     args = ap.parse_args()
 
     from catenary.contact import simulate_contact
@@ -73,11 +76,21 @@ def main() -> None:
     travel = v * args.duration
     nsp = int(math.ceil(travel / lp.span)) + 2
     linef = ContactLine(replace(lp, n_spans=nsp))
+    n = int(math.floor(travel / v / args.dt + 1e-9)) + 1
+    zb = 1e-3 * np.cumsum(rng.standard_normal(n)) * math.sqrt(args.dt)
+    kw = dict(speed=v, x_start=lp.span, x_end=lp.span + travel, dt=args.dt, base_z=zb,
+              base_zdot=np.gradient(zb, args.dt))
     t0 = time.perf_counter()
-    simulate_contact(linef, col, speed=v, x_start=lp.span, x_end=lp.span + travel, dt=args.dt)
+    simulate_contact(linef, col, **kw)
     wf = time.perf_counter() - t0
     print(f"contact, full line {nsp} spans ({linef.n_dof} DOFs), {args.duration:g} s: "
           f"{wf:.1f} s wall; ratio to tractor alone {wf / w_tractor:.2f}")
+    if args.frame_friction > 0:
+        t0 = time.perf_counter()
+        simulate_contact(linef, replace(col, friction=args.frame_friction), **kw)
+        wfr = time.perf_counter() - t0
+        print(f"the same with {args.frame_friction:g} N frame friction: {wfr:.1f} s wall; "
+              f"ratio to without {wfr / wf:.2f}")
 
 
 if __name__ == "__main__":
