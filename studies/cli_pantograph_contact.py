@@ -219,7 +219,7 @@ def _run_grid(args: argparse.Namespace) -> int:
         frames=args.frames or FRAME_FACTORS, mounts=args.mounts or MOUNT_FACTORS,
         speed_kmh=args.speed_kmh, duration=args.duration, line=args.line,
         pantograph=args.pantograph, dt=args.dt, seeds=args.seeds, seed=args.seed,
-        command=sys.argv, **sweep_kwargs(args))
+        frame_friction=args.frame_friction, command=sys.argv, **sweep_kwargs(args))
     if args.json:
         print(json.dumps(s, indent=2, default=str))
         return 0

@@ -125,7 +125,7 @@ def _frame_value(frame):
 def study_cases(road_spec: dict, *, frames=FRAME_FACTORS, mounts=MOUNT_FACTORS,
                 speed_kmh: float = 80.0, duration: float = 30.0, t_skip: float = 1.0,
                 line: str = "truck_ohl", pantograph: str = "truck", dt: float = 1e-3,
-                vehicle: str = "e_tractor") -> list[dict]:
+                vehicle: str = "e_tractor", frame_friction: float | None = None) -> list[dict]:
     """Case list: every frame x mount configuration, then one case with the base still.
 
     Parameters
@@ -136,7 +136,7 @@ def study_cases(road_spec: dict, *, frames=FRAME_FACTORS, mounts=MOUNT_FACTORS,
         Frame stiffness factors [-] and/or ``"rigid"``.
     mounts : sequence of float
         DCDC mount stiffness factors [-].
-    speed_kmh, duration, t_skip, line, pantograph, dt, vehicle
+    speed_kmh, duration, t_skip, line, pantograph, dt, vehicle, frame_friction
         As :func:`studies.pantograph_contact.contact_drive`.
 
     Returns
@@ -144,6 +144,9 @@ def study_cases(road_spec: dict, *, frames=FRAME_FACTORS, mounts=MOUNT_FACTORS,
     list of dict
         JSON-able cases for :func:`contact_case`; the still-base case is the last one
         (frame 1, mount 1: its drive only sets the travel, its base motion is scaled by 0).
+        A line or pantograph given as a file carries the file's sha256, so a cached case
+        is not reused after the file was edited (the built-in files are part of the
+        cache's code version).
     """
     frames = [_frame_value(f) for f in frames]
     mounts = [float(m) for m in mounts]
@@ -157,6 +160,16 @@ def study_cases(road_spec: dict, *, frames=FRAME_FACTORS, mounts=MOUNT_FACTORS,
     base = {"vehicle": str(vehicle), "road": road_spec, "speed_kmh": float(speed_kmh),
             "duration": float(duration), "t_skip": float(t_skip), "line": str(line),
             "pantograph": str(pantograph), "dt": float(dt)}
+    for key, value in (("line", line), ("pantograph", pantograph)):
+        if Path(value).suffix.lower() == ".toml" and Path(value).is_file():
+            from eroad.archive import file_sha256
+
+            base[f"{key}_sha256"] = file_sha256(value)
+    if frame_friction is not None:  # absent otherwise: cases cached before it stay valid
+        if not (math.isfinite(frame_friction) and frame_friction >= 0):
+            raise EroadInputError(f"frame friction must be a finite force >= 0 N, got "
+                                  f"{frame_friction}")
+        base["frame_friction"] = float(frame_friction)
     cases = [{**base, "frame": f, "mount": m, "base_scale": 1.0}
              for m in mounts for f in frames]
     cases.append({**base, "frame": 1.0, "mount": 1.0, "base_scale": 0.0})
@@ -233,7 +246,8 @@ def contact_case(case: dict) -> dict:
                         pantograph=case["pantograph"], chassis=chassis, frame_factor=ff,
                         mount_factor=float(case["mount"]), dt=float(case["dt"]),
                         t_skip=float(case["t_skip"]), compare_static=False,
-                        base_scale=float(case["base_scale"]))
+                        base_scale=float(case["base_scale"]),
+                        frame_friction=case.get("frame_friction"))
     res = out["result"]
     modes, _ = mode_table(tractor_variant(case["vehicle"], float(case["mount"])), chassis, ff,
                           f_max=80.0)
@@ -743,7 +757,8 @@ def _summary(table, cases, sweep, road_label: str) -> dict:
     tot = sum(band_ms.values())
     return {
         "study": STUDY, "road": road_label, "speed_kmh": float(c0["speed_kmh"]),
-        "line": c0["line"], "pantograph": c0["pantograph"], "dt_s": float(c0["dt"]),
+        "line": c0["line"], "pantograph": c0["pantograph"],
+        "frame_friction_N": c0.get("frame_friction"), "dt_s": float(c0["dt"]),
         "n_configurations": int(len(drive)), "duration_s": float(still["duration_s"]),
         "base_still": {k: float(still[k]) for k in ("mean_N", "sd_N", "fm_minus_3sd_N",
                                                       "min_N", "max_N", "loss_percent")},
@@ -802,7 +817,8 @@ def run_pantograph_chassis(road_path: str | Path, out_root: str | Path = "result
                            mounts=MOUNT_FACTORS, speed_kmh: float = 80.0,
                            duration: float = 30.0, line: str = "truck_ohl",
                            pantograph: str = "truck", dt: float = 1e-3, seeds: int = 0,
-                           seed: int = 2026, scheduler: Any = None,
+                           seed: int = 2026, frame_friction: float | None = None,
+                           scheduler: Any = None,
                            n_workers: int = 2, cache_dir: str | Path = ".eroad-cache",
                            progress: bool = True, command: list[str] | None = None) -> dict:
     """Run the study on a road and archive it.
@@ -818,7 +834,7 @@ def run_pantograph_chassis(road_path: str | Path, out_root: str | Path = "result
         A named run folder instead (must not exist or be empty; written as a hidden
         temporary folder and renamed into place, ``run.json`` by
         :func:`eroad.archive.run_info`).
-    frames, mounts, speed_kmh, duration, line, pantograph, dt
+    frames, mounts, speed_kmh, duration, line, pantograph, dt, frame_friction
         See :func:`study_cases`.
     seeds, seed
         Statistically equivalent road realisations driven besides the file, and their
@@ -852,7 +868,8 @@ def run_pantograph_chassis(road_path: str | Path, out_root: str | Path = "result
     cases = []
     for k, spec in enumerate(specs):
         cs = study_cases(spec, frames=frames, mounts=mounts, speed_kmh=speed_kmh,
-                         duration=duration, line=line, pantograph=pantograph, dt=dt)
+                         duration=duration, line=line, pantograph=pantograph, dt=dt,
+                         frame_friction=frame_friction)
         if k:
             cs = [{**c, "road_label": spec["label"]} for c in cs[:-1]]
         cases.append(cs)
@@ -867,9 +884,12 @@ def run_pantograph_chassis(road_path: str | Path, out_root: str | Path = "result
               "realisations_from": how,
               "force_bands_hz": [[lo, -1.0 if hi is None else hi] for lo, hi in FORCE_BANDS],
               "n_cases": len(cases), "case_function": "studies.pantograph_chassis:contact_case"}
+    if frame_friction is not None:
+        config["frame_friction_N"] = float(frame_friction)
     version = code_version()
     title = (f"Pantograph contact force vs frame and DCDC-mount stiffness: {p.name}, "
-             f"{speed_kmh:g} km/h, line {line}, pantograph {pantograph}")
+             f"{speed_kmh:g} km/h, line {line}, pantograph {pantograph}"
+             + ("" if frame_friction is None else f" with {frame_friction:g} N frame friction"))
 
     def compute(folder: Path) -> dict:
         sweep = run_cases(contact_case, cases, cache_dir=cache_dir, scheduler=scheduler,

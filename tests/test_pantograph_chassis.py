@@ -220,3 +220,44 @@ def test_grid_over_equivalent_roads(tiny, capsys):
     err = capsys.readouterr().err
     assert ex.value.code == 2 and "--seeds: '-1' must be >= 0" in err and "Traceback" not in err
     assert not (out / "x").exists()
+
+
+def test_pantograph_file_and_friction_enter_the_cache_key(tiny, tmp_path):
+    """A pantograph given as a file carries its sha256 in every case (the built-in files are in
+    the cache's code version, a user's file is not): editing the file must not reuse a cached
+    case.  ``frame_friction`` enters the case only when given, so cases cached before it
+    existed stay valid; a negative value is refused in one line."""
+    from eroad.errors import EroadInputError
+    from studies.chassis_study import road_specs
+    from vehicles.pantograph_model import DATA_DIR
+
+    spec = road_specs(tiny[3], n_seeds=0)[0][0]
+    plain = study_cases(spec, frames=(1.0,), mounts=(1.0,))
+    assert all("frame_friction" not in c and "pantograph_sha256" not in c for c in plain)
+    f = tmp_path / "p.toml"
+    f.write_text((DATA_DIR / "pantograph_truck.toml").read_text())
+    a = study_cases(spec, frames=(1.0,), mounts=(1.0,), pantograph=str(f), frame_friction=5.0)
+    assert all(c["frame_friction"] == 5.0 for c in a)
+    f.write_text(f.read_text().replace("static_force = 70.0", "static_force = 80.0"))
+    b = study_cases(spec, frames=(1.0,), mounts=(1.0,), pantograph=str(f), frame_friction=5.0)
+    assert a[0]["pantograph_sha256"] != b[0]["pantograph_sha256"]
+    with pytest.raises(EroadInputError, match="frame friction must be a finite force >= 0"):
+        study_cases(spec, frames=(1.0,), mounts=(1.0,), frame_friction=-1.0)
+
+
+def test_frame_friction_passes_the_base_motion_on_and_is_not_linear(tiny):
+    """With 20 N of frame friction the frame is dragged by the base (up to the friction
+    force) instead of through the 70 N s/m damper alone: the base-induced force grows, and
+    doubling the base motion no longer doubles it (Coulomb friction is not linear; the
+    friction-free contact is, see test_contact_force_linear_in_base_motion)."""
+    from studies.chassis_study import road_specs
+
+    spec = road_specs(tiny[3], n_seeds=0)[0][0]
+    plain = study_cases(spec, frames=(1.0,), mounts=(1.0,), duration=4.0)
+    fric = study_cases(spec, frames=(1.0,), mounts=(1.0,), duration=4.0, frame_friction=20.0)
+    f0 = {s: contact_case({**plain[0], "base_scale": s})["force"] for s in (0.0, 1.0)}
+    f = {s: contact_case({**fric[0], "base_scale": s})["force"] for s in (0.0, 1.0, 2.0)}
+    d_plain = np.std(f0[1.0] - f0[0.0])
+    d1, d2 = f[1.0] - f[0.0], f[2.0] - f[0.0]
+    assert np.std(d1) > 1.5 * d_plain
+    assert np.max(np.abs(d2 - 2 * d1)) > 0.05 * np.max(np.abs(d2))
