@@ -286,20 +286,22 @@ def _save(run, out: dict) -> None:
     tm, offset, yb = out["lateral_series"]
     np.savez_compressed(run.data_dir / "contact.npz", time=res.time, x=res["x"],
                         force=res["force"], head_z=res["head_z"], uplift=res["uplift"],
-                        base_z=res["base_z"], lateral_time=tm, lateral_offset=offset,
-                        base_y_head=yb, **extra)
+                        base_z=res["base_z"], friction=res["friction"], lateral_time=tm,
+                        lateral_offset=offset, base_y_head=yb, **extra)
 
 
 def plot_contact(folder: str | Path, path: str | Path) -> list[Path]:
     """Contact force (with and without base motion), base motion and lateral offset from
-    a saved ``contact.npz`` (``folder`` is the run's ``data/``); writes PNG and PDF."""
+    a saved ``contact.npz`` (``folder`` is the run's ``data/``), and the frame friction
+    force when the pantograph has friction; writes PNG and PDF."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     d = np.load(Path(folder) / "contact.npz")
-    fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=False)
+    fric = "friction" in d and bool(np.any(d["friction"] != 0.0))
+    fig, ax = plt.subplots(4 if fric else 3, 1, figsize=(9, 10.5 if fric else 8), sharex=False)
     ax[0].plot(d["time"], d["force"], lw=0.6, label="base motion from the drive")
     if "static_force" in d:
         ax[0].plot(d["time"], d["static_force"], lw=0.6, alpha=0.8, label="base at rest")
@@ -319,6 +321,14 @@ def plot_contact(folder: str | Path, path: str | Path) -> list[Path]:
     ax[2].set_ylabel("lateral [mm]")
     ax[2].set_xlabel("time [s]")
     ax[2].legend(loc="upper right", fontsize=8)
+    if fric:
+        ax[3].plot(d["time"], d["friction"], lw=0.6, color="tab:red",
+                   label="frame friction on the lower frame (drive)")
+        fmax = float(np.max(np.abs(d["friction"])))
+        ax[3].set_ylim(-1.2 * fmax, 1.6 * fmax)  # room for the legend above the slip level
+        ax[3].set_ylabel("friction force [N]")
+        ax[3].set_xlabel("time [s]")
+        ax[3].legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     return save_png_pdf(fig, path, dpi=120)
 

@@ -227,3 +227,28 @@ def test_welded_contact_dof_matches_a_stiff_spring_weld(short_line):
     sd = np.std(ref["force"])
     assert sd > 20.0 and ref["force"].min() == 0.0
     assert np.max(np.abs(r["force"] - ref["force"])) < 0.03 * sd
+
+
+def test_drive_with_friction_archives_the_friction_force(tmp_path, capsys):
+    """``eroad pantograph-contact --frame-friction 20`` on a short class D drive: the run's
+    ``contact.npz`` carries the friction force, bounded by 20 N and at 20 N while the frame
+    slips; the summary and the printout name the friction."""
+    import json
+
+    from eroad.cli import main
+
+    road = tmp_path / "road.npz"
+    assert main(["road", "generate", "--class", "D", "--length", "150", "--width", "4",
+                 "--seed", "3", "--out", str(road)]) == 0
+    assert main(["pantograph-contact", "--road", str(road), "--out", str(tmp_path / "o"),
+                 "--duration", "4", "--no-compare", "--frame-friction", "20"]) == 0
+    out = capsys.readouterr().out
+    assert "frame friction 20 N" in out
+    run = next((tmp_path / "o" / "pantograph_contact").iterdir())
+    d = np.load(run / "data" / "contact.npz")
+    fr = d["friction"]
+    assert np.abs(fr).max() <= 20.0 + 1e-9
+    assert np.mean(np.isclose(np.abs(fr), 20.0)) > 0.1  # slips some of the time
+    s = json.loads((run / "summary.json").read_text())
+    assert s["config"]["frame_friction_N"] == 20.0
+    assert (run / "figures" / "contact.png").is_file()
