@@ -30,13 +30,14 @@ def one(road, friction: float, speed_kmh: float) -> dict:
     w0 = time.perf_counter()
     out = contact_drive(road, speed_kmh=speed_kmh, frame_friction=friction)
     res, rest = out["result"], out["static"]
-    sel = res.time >= 1.0
-    ff = np.abs(res["friction"][sel])
-    stuck = float(np.mean(ff < friction * (1 - 1e-9))) if friction > 0 else float("nan")
-    ff0 = np.abs(rest["friction"][sel])
-    stuck0 = float(np.mean(ff0 < friction * (1 - 1e-9))) if friction > 0 else float("nan")
+    def stuck(r) -> float:
+        """Share of the samples after the first second with the frame below its slip force."""
+        if friction <= 0:
+            return float("nan")
+        return float(np.mean(np.abs(r["friction"][r.time >= 1.0]) < friction * (1 - 1e-9)))
+
     return {"friction_N": friction, "drive": out["stats"], "base_at_rest": out["stats_static"],
-            "stuck_share": stuck, "stuck_share_at_rest": stuck0,
+            "stuck_share": stuck(res), "stuck_share_at_rest": stuck(rest),
             "duration_s": out["config"]["duration_s"], "base_z_rms_mm": 1e3 * out["config"]["base_z_rms_m"],
             "wall_s": time.perf_counter() - w0}
 

@@ -166,10 +166,10 @@ def study_cases(road_spec: dict, *, frames=FRAME_FACTORS, mounts=MOUNT_FACTORS,
 
             base[f"{key}_sha256"] = file_sha256(value)
     if frame_friction is not None:  # absent otherwise: cases cached before it stay valid
-        if not (math.isfinite(frame_friction) and frame_friction >= 0):
-            raise EroadInputError(f"frame friction must be a finite force >= 0 N, got "
-                                  f"{frame_friction}")
-        base["frame_friction"] = float(frame_friction)
+        from vehicles.pantograph_model import load_pantograph, with_frame_friction
+
+        base["frame_friction"] = with_frame_friction(load_pantograph(pantograph),
+                                                     frame_friction).frame_friction
     cases = [{**base, "frame": f, "mount": m, "base_scale": 1.0}
              for m in mounts for f in frames]
     cases.append({**base, "frame": 1.0, "mount": 1.0, "base_scale": 0.0})

@@ -165,7 +165,8 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
     """
     from studies.figure11 import (DEFAULT_VEHICLE, drive_base_motion, max_duration,
                                   tractor_variant)
-    from vehicles.pantograph_model import collector, lateral_response, load_pantograph
+    from vehicles.pantograph_model import (collector, lateral_response, load_pantograph,
+                                           with_frame_friction)
 
     if not (math.isfinite(speed_kmh) and 0 < speed_kmh <= 200):
         raise EroadInputError(f"speed must be in (0, 200] km/h, got {speed_kmh}")
@@ -174,11 +175,7 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
     if not (math.isfinite(base_scale) and base_scale >= 0):
         raise EroadInputError(f"base_scale must be a finite number >= 0, got {base_scale}")
     pp = load_pantograph(pantograph)
-    if frame_friction is not None:
-        if not (math.isfinite(frame_friction) and frame_friction >= 0):
-            raise EroadInputError(f"frame friction must be a finite force >= 0 N, got "
-                                  f"{frame_friction}")
-        pp = replace(pp, frame_friction=float(frame_friction))
+    pp = with_frame_friction(pp, frame_friction)
     v = speed_kmh / 3.6
     vp = tractor_variant(DEFAULT_VEHICLE, mount_factor)
     # whole seconds, at least half a second short of the road's end: with t_max - 0.5

@@ -26,7 +26,7 @@ contact line (:mod:`catenary`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +35,7 @@ from catenary.contact import Collector
 from eroad.errors import EroadInputError
 
 __all__ = ["PantographParams", "load_pantograph", "pantograph_ids", "collector",
+           "with_frame_friction",
            "lateral_response", "vertical_modes", "DATA_DIR"]
 
 #: folder of the built-in pantograph files
@@ -141,6 +142,21 @@ def load_pantograph(name_or_path: str | Path) -> PantographParams:
     pp = PantographParams(**kw)
     pp.validate(str(p))
     return pp
+
+
+def with_frame_friction(pp: PantographParams, friction: float | None) -> PantographParams:
+    """``pp`` with its ``frame_friction`` replaced by ``friction`` [N] (None: ``pp`` as is).
+
+    Raises
+    ------
+    EroadInputError
+        A negative or non-finite friction.
+    """
+    if friction is None:
+        return pp
+    if not (math.isfinite(friction) and friction >= 0):
+        raise EroadInputError(f"frame friction must be a finite force >= 0 N, got {friction}")
+    return replace(pp, frame_friction=float(friction))
 
 
 def _matrices(pp: PantographParams):
