@@ -51,9 +51,9 @@ def oracle_fits(dataset: Path, truth: dict, track_y=(-0.9, 0.9)) -> list:
     Whittle fit (:func:`roadlib.metrics.fit_iso_psd`) over the segment's own true
     band [nmin, nmax].  No response-based method can know more about a segment's
     spectrum than the exact profile it drove over; this fit is one estimator of it, not
-    the information limit (its taper spends information: on 3-5 s segments of `null`
-    drives it gets the class right in 79 % where the Cramer-Rao bound of the same profile
-    allows 87-91 %, results/inverse_blind/20261129-class-bound/).
+    the information limit (on 3-5 s segments of `null` drives it gets the class right in
+    79 % where the Cramer-Rao bound of the same profile allows 87-91 %,
+    results/inverse_blind/20261129-class-bound/).
     """
     from roadlib.surface import RoadSurface
 
