@@ -40,29 +40,43 @@ W_GRID = np.round(np.arange(1.2, 3.0001, 0.02), 3)
 NOISE_PSD = 0.03 ** 2 / 100.0
 
 
+def periodograms(acc, m):
+    """Tukey(0.2)-tapered one-sided periodograms [unit^2/Hz] of the channels ``acc`` over the samples
+    ``m`` (200 Hz), each with its mean removed: (f, I) with I of shape (channels, nf)."""
+    win = tukey(m.sum(), 0.2)
+    scale = 1.0 / (200.0 * np.sum(win ** 2))
+    f = np.fft.rfftfreq(m.sum(), 1 / 200.0)
+    I = []
+    for a in acc:
+        x = a[m] - a[m].mean()
+        I.append(2 * scale * np.abs(np.fft.rfft(x * win)) ** 2)
+    return f, np.array(I)
+
+
+def expected_psd(lm, H, f, road, speeds):
+    """The linear model's response PSD of the channels of ``H`` (nf, channel, contact) for the road
+    dict ``road``, averaged over ``speeds``: shape (channels, nf)."""
+    P = np.zeros((H.shape[1], f.size))
+    for sp in speeds:
+        S = lm.road_cross_spectrum(road, sp, f)
+        P += np.einsum("fod,fod->fo", H @ S, H.conj()).real.T / len(speeds)
+    return P
+
+
 def fit_segment(lm, H, t, acc, v, t0, t1, fmax=45.0):
     m = (t >= t0) & (t < t1)
     vs = v[m]
     T = m.sum() / 200.0
     f_lo, f_hi = max(1.5, 0.12 * vs.max()), min(fmax, 4.8 * vs.min())
-    win = tukey(m.sum(), 0.2)
-    scale = 1.0 / (200.0 * np.sum(win ** 2))
-    f = np.fft.rfftfreq(m.sum(), 1 / 200.0)
+    f, I = periodograms(acc, m)
     band = (f >= f_lo) & (f <= f_hi)
     fb = f[band]
-    I = []
-    for a in acc:
-        x = a[m] - a[m].mean()
-        I.append(2 * scale * np.abs(np.fft.rfft(x * win)) ** 2)
-    I = np.array(I)[:, band]                             # (2, nb)
+    I = I[:, band]                                       # (2, nb)
     Hb = H[band] if H is not None else None
     speeds = np.quantile(vs, [1 / 6, 0.5, 5 / 6])
     prof, lgs = [], []
     for w in W_GRID:
-        P = np.zeros((len(CHANNELS), fb.size))
-        for sp in speeds:
-            S = lm.road_cross_spectrum({"Gq_n0": 1.0, "w": float(w), "nmin": 0.01, "nmax": 100.0, "lam": 1.0}, sp, fb)
-            P += np.einsum("fod,fod->fo", Hb @ S, Hb.conj()).real.T / speeds.size
+        P = expected_psd(lm, Hb, fb, {"Gq_n0": 1.0, "w": float(w), "nmin": 0.01, "nmax": 100.0, "lam": 1.0}, speeds)
 
         def nll(lg):
             E = math.exp(lg) * P + NOISE_PSD
