@@ -122,6 +122,32 @@ def sensitivity_line(sens: dict) -> str:
     return ", ".join(f"{k} x{v['factor']:.2f}" for k, v in sens.items())
 
 
+def twin_tyre_axles(lm) -> list:
+    """Axles of the linear model with two or more tyres on a side (twin tyres), ascending."""
+    per = {}
+    for c in lm.contacts:
+        per.setdefault((c["axle"], c["side"]), []).append(c["y"])
+    return sorted({a for (a, _), ys in per.items() if len(ys) > 1})
+
+
+def fitted_axles(channels) -> list:
+    """Axle numbers of channels named ``<quantity>_<axle><side>`` (measurement format), ascending."""
+    import re
+
+    out = set()
+    for c in channels:
+        m = re.search(r"_(\d+)[LR]$", str(c))
+        if m:
+            out.add(int(m.group(1)))
+    return sorted(out)
+
+
+#: what the twin-tyre note quotes: the independent truck's five measured-profile drives (seeds 1-5),
+#: whose twin tyres run on one profile; G(1 cycle/m) fitted / the profile under each segment, median
+#: (results/roads/20261129-measured-lateral/: axle 3 alone, axle 3 told that structure, every axle)
+TWIN_EVIDENCE = "1.34x with axle 3 alone, 0.92x once told that structure, 1.02x with every axle"
+
+
 def run_summary(vehicle, segments, time, speed, channels, *, effects=None, chassis="rigid") -> dict:
     """The lateral-structure entry of an inversion's ``summary.json``.
 
@@ -154,6 +180,9 @@ def run_summary(vehicle, segments, time, speed, channels, *, effects=None, chass
         return {"assumed": ASSUMED, "error": f"sensitivity not computed: {exc}"}
     time = np.asarray(time, float)
     speed = np.asarray(speed, float)
+    twins = twin_tyre_axles(lm)
+    fitted = fitted_axles(channels)
+    twin_only = bool(fitted) and set(fitted) <= set(twins)
     rows, rng = [], {}
     for i, s in enumerate(segments):
         m = (time >= s["t_start"]) & (time <= s["t_end"])
@@ -169,6 +198,7 @@ def run_summary(vehicle, segments, time, speed, channels, *, effects=None, chass
             rng[k] = (min(lo, d["factor"]), max(hi, d["factor"]))
     return {"assumed": ASSUMED, "segments": rows,
             "factor_range": {k: [float(a), float(b)] for k, (a, b) in rng.items()},
+            "fitted_axles": fitted, "twin_tyre_axles": twins, "twin_tyres_only": twin_only,
             "meaning": "the level Gd(n0) the fit would have returned under that lateral structure "
                        "is 'factor' times the reported one (linear truck, waviness held)"}
 
@@ -180,6 +210,14 @@ def note_line(entry: dict) -> str:
     parts = []
     for k, (a, b) in entry["factor_range"].items():
         parts.append(f"{k} x{a:.2f}" if abs(b - a) < 0.005 else f"{k} x{a:.2f}-{b:.2f}")
-    return (f"Lateral road structure assumed: {entry['assumed']}; not identified by the data. "
+    line = (f"Lateral road structure assumed: {entry['assumed']}; not identified by the data. "
             "Had it been otherwise, the fitted Gd(n0) would be (over the segments): "
             + ", ".join(parts) + " (docs/inverse.md, section 13).")
+    if entry.get("twin_tyres_only"):
+        singles = sorted(set(range(1, max(entry["twin_tyre_axles"]) + 1)) - set(entry["twin_tyre_axles"]))
+        line += (" Every fitted axle runs on twin tyres, whose level hangs most on how alike the twins' "
+                 "tracks are ('duals in one rut'): on drives whose twin tyres ran on one profile G(1 cycle/m) "
+                 f"came out {TWIN_EVIDENCE}" + (f"; fit axle {' or '.join(map(str, singles))} too "
+                                                "(--channels axles) where the drive logs it" if singles else "")
+                 + ".")
+    return line

@@ -74,3 +74,20 @@ def test_run_summary_and_note():
     assert line.startswith("Lateral road structure assumed: isotropic") and "duals in one rut x" in line
     bad = lateral.run_summary("dump_truck_8x4", segs, t, v, ["nope"])
     assert "not computed" in bad["error"] and "not computed" in lateral.note_line(bad)
+
+
+def test_twin_tyre_note_only_where_every_fitted_axle_has_twins(lm):
+    import numpy as np
+
+    # dump_truck_8x4: single tyres on axles 1-2, twins on 3-4 (vehicles/params/dump_truck_8x4.toml)
+    assert lateral.twin_tyre_axles(lm) == [3, 4]
+    assert lateral.fitted_axles(["susp_disp_3L", "axle_acc_12R", "speed"]) == [3, 12]
+    t = np.arange(0, 10, 0.005)
+    v = np.full_like(t, 10.0)
+    segs = [dict(SEG, t_start=0.0, t_end=10.0)]
+    rear = lateral.run_summary("dump_truck_8x4", segs, t, v, ["susp_disp_3L", "susp_disp_3R", "axle_acc_4L"])
+    assert rear["twin_tyres_only"] and rear["fitted_axles"] == [3, 4]
+    line = lateral.note_line(rear)
+    assert "twin tyres" in line and "fit axle 1 or 2 too" in line
+    every = lateral.run_summary("dump_truck_8x4", segs, t, v, ["axle_acc_1L", "axle_acc_3L", "susp_disp_3L"])
+    assert not every["twin_tyres_only"] and "twin tyres" not in lateral.note_line(every)
