@@ -1,0 +1,80 @@
+"""Does the road's lateral structure confound the diagnosis on the measured-profile drives?
+
+A counterfactual: the same blind drive diagnosed twice, with the diagnosis's simulations as they are (twin
+tyres read the isotropic surface at their own lateral positions) and with every twin tyre of a side
+reading ONE track (the wheel station's centre line: vehicles.simulate.road_under_tyres patched in this
+process; the pool's workers fork after the patch).  The measured-profile road of the independent truck
+puts a side's twin tyres on one profile (results/roads/20261129-measured-lateral/).
+
+Usage: python twin_check.py WORK SEED:SCENARIO:EFFECT[:PARAM=VALUE] ...   (--twins-one-track to patch)
+Writes WORK/<seed>-<mode>.json (verdict, confidence, ranking summary, wall time).
+"""
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
+
+
+def _one_track_per_side(road, model, x_start, y_offset, s, v):
+    """vehicles.simulate.road_under_tyres with each side's tyres of one axle on one track (their mean y)."""
+    vp = model.vp
+    n = s.size
+    z = np.empty((n, len(model.contacts)))
+    z_t = np.empty_like(z)
+    gx, dx = road.x, road.dx
+    ys = {}
+    for ct in model.contacts:
+        ys.setdefault((ct.axle, np.sign(ct.y)), []).append(ct.y)
+    for c, ct in enumerate(model.contacts):
+        track = road.track(y_offset + float(np.mean(ys[(ct.axle, np.sign(ct.y))])))
+        xq = x_start + vp.axles[ct.axle].x + s
+        z[:, c] = np.interp(xq, gx, track)
+        i = np.clip(((xq - gx[0]) / dx).astype(np.intp), 0, gx.size - 2)
+        z_t[:, c] = (track[i + 1] - track[i]) / dx * v
+    return z, z_t
+
+
+def main(argv):
+    twins = "--twins-one-track" in argv
+    argv = [a for a in argv if a != "--twins-one-track"]
+    if twins:
+        import vehicles.simulate as vs
+        vs.road_under_tyres = _one_track_per_side
+    from diagnosis.blind import BLIND_SETTINGS
+    from diagnosis.pipeline import diagnose
+    from drives.synth import copy_without_truth, synth_command
+
+    work = Path(argv[0])
+    work.mkdir(parents=True, exist_ok=True)
+    mode = "twins-one-track" if twins else "as-is"
+    for spec in argv[1:]:
+        parts = spec.split(":")
+        seed, scen, eff = int(parts[0]), parts[1], parts[2]
+        effects = [f"{eff}.{parts[3]}"] if len(parts) > 3 else []
+        ds, blind = work / f"{seed}", work / f"{seed}-blind"
+        if not (ds / "truth" / "summary.json").is_file():
+            synth_command(scenario=scen, seed=seed, effects=effects, out=ds, force=True, duration=None)
+        if not blind.exists():
+            copy_without_truth(ds, blind)
+        t = time.perf_counter()
+        summ = diagnose(blind, work / f"{seed}-run-{mode}", workers=2, force=True, settings=dict(BLIND_SETTINGS),
+                        progress=lambda m: None)
+        wall = time.perf_counter() - t
+        det = summ.get("verdict_detail") or {}
+        rank = [(e["effect"], e.get("parameters"), round(float(e.get("shrink_fraction", 0)), 3))
+                for e in summ.get("ranking", [])[:4]]
+        out = {"seed": seed, "scenario": scen, "truth": eff, "truth_value": parts[3] if len(parts) > 3 else None,
+               "mode": mode, "verdict": summ["verdict"], "confidence": summ.get("verdict_confidence"),
+               "ranking_verdict": det.get("ranking_verdict"), "explained_share": det.get("explained_share"),
+               "heldout_gap_before": summ["nominal"]["heldout_gap"], "null_sd": summ["nominal"]["null_gap_std"],
+               "ranking": rank, "wall_s": round(wall, 1)}
+        (work / f"{seed}-{mode}.json").write_text(json.dumps(out, indent=1))
+        print(json.dumps(out), flush=True)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
