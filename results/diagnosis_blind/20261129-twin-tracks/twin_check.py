@@ -6,7 +6,10 @@ reading ONE track (the wheel station's centre line: vehicles.simulate.road_under
 process; the pool's workers fork after the patch).  The measured-profile road of the independent truck
 puts a side's twin tyres on one profile (results/roads/20261129-measured-lateral/).
 
-Usage: python twin_check.py WORK SEED:SCENARIO:EFFECT[:PARAM=VALUE] ...   (--twins-one-track to patch)
+--mixed-road: the diagnosis's road built as the measured-profile road is, from two unrelated ISO profiles
+mixed linearly across the width (the whole lateral structure of that road, not only the twins).
+
+Usage: python twin_check.py WORK SEED:SCENARIO:EFFECT[:PARAM=VALUE] ...   [--twins-one-track | --mixed-road]
 Writes WORK/<seed>-<mode>.json (verdict, confidence, ranking summary, wall time).
 """
 import json
@@ -38,19 +41,42 @@ def _one_track_per_side(road, model, x_start, y_offset, s, v):
     return z, z_t
 
 
+def _mixed_road_patch():
+    """The diagnosis's road built as the measured-profile road is (drives.synth.build_profile_road), from
+    two unrelated ISO profiles instead of one measured profile and its 40 m shift:
+    z(x, y) = a(y) p1(x) + (1 - a(y)) p2(x), a = 0.5 + y / width; p1, p2 the centre tracks of the
+    diagnosis's own surface for this seed and for another seed (same segments)."""
+    from diagnosis import pipeline
+    from roadlib.surface import RoadSurface
+
+    orig = pipeline.TruckModel._road
+
+    def _road(self, t0, t1, seed, gq):
+        r1 = orig(self, t0, t1, seed, gq)
+        r2 = orig(self, t0, t1, int(seed) + 7777, gq)
+        width = float(r1.y[-1] - r1.y[0])
+        a = 0.5 + r1.y / width
+        p1, p2 = r1.track(0.0), r2.track(0.0)
+        return RoadSurface(r1.x, r1.y, a[None, :] * p1[:, None] + (1 - a[None, :]) * p2[:, None], dict(r1.meta))
+    pipeline.TruckModel._road = _road
+
+
 def main(argv):
     twins = "--twins-one-track" in argv
-    argv = [a for a in argv if a != "--twins-one-track"]
+    mixed = "--mixed-road" in argv
+    argv = [a for a in argv if a not in ("--twins-one-track", "--mixed-road")]
     if twins:
         import vehicles.simulate as vs
         vs.road_under_tyres = _one_track_per_side
+    if mixed:
+        _mixed_road_patch()
     from diagnosis.blind import BLIND_SETTINGS
     from diagnosis.pipeline import diagnose
     from drives.synth import copy_without_truth, synth_command
 
     work = Path(argv[0])
     work.mkdir(parents=True, exist_ok=True)
-    mode = "twins-one-track" if twins else "as-is"
+    mode = "mixed-road" if mixed else "twins-one-track" if twins else "as-is"
     for spec in argv[1:]:
         parts = spec.split(":")
         seed, scen, eff = int(parts[0]), parts[1], parts[2]
