@@ -24,6 +24,7 @@ isotropic one) or a fit of ``lam`` (one drive does not resolve it).
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -132,8 +133,6 @@ def twin_tyre_axles(lm) -> list:
 
 def fitted_axles(channels) -> list:
     """Axle numbers of channels named ``<quantity>_<axle><side>`` (measurement format), ascending."""
-    import re
-
     out = set()
     for c in channels:
         m = re.search(r"_(\d+)[LR]$", str(c))
@@ -142,10 +141,11 @@ def fitted_axles(channels) -> list:
     return sorted(out)
 
 
-#: what the twin-tyre note quotes: the independent truck's five measured-profile drives (seeds 1-5),
+#: what the twin-tyre note quotes: the independent 8x4 truck's five measured-profile drives (seeds 1-5),
 #: whose twin tyres run on one profile; G(1 cycle/m) fitted / the profile under each segment, median
 #: (results/roads/20261129-measured-lateral/: axle 3 alone, axle 3 told that structure, every axle)
-TWIN_EVIDENCE = "1.34x with axle 3 alone, 0.92x once told that structure, 1.02x with every axle"
+TWIN_EVIDENCE = ("1.34x with axle 3 alone, 0.92x once told that structure, 1.02x with every axle "
+                 "(8x4 dump truck, a measured profile)")
 
 
 def run_summary(vehicle, segments, time, speed, channels, *, effects=None, chassis="rigid") -> dict:
@@ -181,6 +181,7 @@ def run_summary(vehicle, segments, time, speed, channels, *, effects=None, chass
     time = np.asarray(time, float)
     speed = np.asarray(speed, float)
     twins = twin_tyre_axles(lm)
+    singles = sorted({c["axle"] for c in lm.contacts} - set(twins))
     fitted = fitted_axles(channels)
     twin_only = bool(fitted) and set(fitted) <= set(twins)
     rows, rng = [], {}
@@ -198,7 +199,8 @@ def run_summary(vehicle, segments, time, speed, channels, *, effects=None, chass
             rng[k] = (min(lo, d["factor"]), max(hi, d["factor"]))
     return {"assumed": ASSUMED, "segments": rows,
             "factor_range": {k: [float(a), float(b)] for k, (a, b) in rng.items()},
-            "fitted_axles": fitted, "twin_tyre_axles": twins, "twin_tyres_only": twin_only,
+            "fitted_axles": fitted, "twin_tyre_axles": twins, "single_tyre_axles": singles,
+            "twin_tyres_only": twin_only,
             "meaning": "the level Gd(n0) the fit would have returned under that lateral structure "
                        "is 'factor' times the reported one (linear truck, waviness held)"}
 
@@ -214,7 +216,7 @@ def note_line(entry: dict) -> str:
             "Had it been otherwise, the fitted Gd(n0) would be (over the segments): "
             + ", ".join(parts) + " (docs/inverse.md, section 13).")
     if entry.get("twin_tyres_only"):
-        singles = sorted(set(range(1, max(entry["twin_tyre_axles"]) + 1)) - set(entry["twin_tyre_axles"]))
+        singles = entry.get("single_tyre_axles") or []
         line += (" Every fitted axle runs on twin tyres, whose level hangs most on how alike the twins' "
                  "tracks are ('duals in one rut'): on drives whose twin tyres ran on one profile G(1 cycle/m) "
                  f"came out {TWIN_EVIDENCE}" + (f"; fit axle {' or '.join(map(str, singles))} too "

@@ -86,7 +86,7 @@ def test_twin_tyre_note_only_where_every_fitted_axle_has_twins(lm):
     v = np.full_like(t, 10.0)
     segs = [dict(SEG, t_start=0.0, t_end=10.0)]
     rear = lateral.run_summary("dump_truck_8x4", segs, t, v, ["susp_disp_3L", "susp_disp_3R", "axle_acc_4L"])
-    assert rear["twin_tyres_only"] and rear["fitted_axles"] == [3, 4]
+    assert rear["twin_tyres_only"] and rear["fitted_axles"] == [3, 4] and rear["single_tyre_axles"] == [1, 2]
     line = lateral.note_line(rear)
     assert "twin tyres" in line and "fit axle 1 or 2 too" in line
     every = lateral.run_summary("dump_truck_8x4", segs, t, v, ["axle_acc_1L", "axle_acc_3L", "susp_disp_3L"])

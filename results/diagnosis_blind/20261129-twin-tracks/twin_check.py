@@ -6,6 +6,8 @@ reading ONE track (the wheel station's centre line: vehicles.simulate.road_under
 process; the pool's workers fork after the patch).  The measured-profile road of the independent truck
 puts a side's twin tyres on one profile (results/roads/20261129-measured-lateral/).
 
+--w-range=LO,HI: the diagnosis's waviness range (pipeline.W_RANGE, 1.2-3.0) set to LO-HI, e.g. the
+inversion's published 1.5-3.5.
 --mixed-road: the diagnosis's road built as the measured-profile road is, from two unrelated ISO profiles
 mixed linearly across the width (the whole lateral structure of that road, not only the twins).
 
@@ -64,7 +66,11 @@ def _mixed_road_patch():
 def main(argv):
     twins = "--twins-one-track" in argv
     mixed = "--mixed-road" in argv
-    argv = [a for a in argv if a not in ("--twins-one-track", "--mixed-road")]
+    wr = next((a for a in argv if a.startswith("--w-range=")), None)
+    argv = [a for a in argv if a not in ("--twins-one-track", "--mixed-road") and a != wr]
+    if wr:   # the diagnosis's waviness range (diagnosis.pipeline.W_RANGE, 1.2-3.0) set to LO,HI
+        from diagnosis import pipeline
+        pipeline.W_RANGE = tuple(float(x) for x in wr.split("=", 1)[1].split(","))
     if twins:
         import vehicles.simulate as vs
         vs.road_under_tyres = _one_track_per_side
@@ -77,6 +83,8 @@ def main(argv):
     work = Path(argv[0])
     work.mkdir(parents=True, exist_ok=True)
     mode = "mixed-road" if mixed else "twins-one-track" if twins else "as-is"
+    if wr:
+        mode = "w" + wr.split("=", 1)[1].replace(",", "-") + ("" if mode == "as-is" else "-" + mode)
     for spec in argv[1:]:
         parts = spec.split(":")
         seed, scen, eff = int(parts[0]), parts[1], parts[2]
