@@ -8,6 +8,10 @@ puts a side's twin tyres on one profile (results/roads/20261129-measured-lateral
 
 --w-range=LO,HI: the diagnosis's waviness range (pipeline.W_RANGE, 1.2-3.0) set to LO-HI, e.g. the
 inversion's published 1.5-3.5.
+--nmax=N: every segment's nmax fixed at N cycles/m instead of fitted (pipeline.fit_nmax replaced; the
+measured profile holds nothing above 2: a truth-informed counterfactual).
+--road-fit=inverse: the diagnosis's road is the inversion's fit of the whole record (``diagnose(road_fit=
+"inverse")``, an existing option, not the default) instead of its own level-and-waviness fit.
 --mixed-road: the diagnosis's road built as the measured-profile road is, from two unrelated ISO profiles
 mixed linearly across the width (the whole lateral structure of that road, not only the twins).
 
@@ -67,7 +71,20 @@ def main(argv):
     twins = "--twins-one-track" in argv
     mixed = "--mixed-road" in argv
     wr = next((a for a in argv if a.startswith("--w-range=")), None)
-    argv = [a for a in argv if a not in ("--twins-one-track", "--mixed-road") and a != wr]
+    nx = next((a for a in argv if a.startswith("--nmax=")), None)
+    rf = "inverse" if "--road-fit=inverse" in argv else "levels"
+    argv = [a for a in argv if a not in ("--twins-one-track", "--mixed-road", "--road-fit=inverse", wr, nx)]
+    if nx:   # every segment's nmax fixed (the truth's band, a counterfactual: the diagnosis cannot know it)
+        import numpy as np_
+        from diagnosis import pipeline as pl
+        val = float(nx.split("=", 1)[1])
+
+        def _fixed_nmax(model, sig, gq, seed=0, diag=None, mapper=map):
+            out = np_.full(len(model.bounds) - 1, val)
+            model.nmax = out
+            model.high_band = {"cut": list(range(out.size)), "rolloff": [], "vetoed": False}
+            return out
+        pl.fit_nmax = _fixed_nmax
     if wr:   # the diagnosis's waviness range (diagnosis.pipeline.W_RANGE, 1.2-3.0) set to LO,HI
         from diagnosis import pipeline
         pipeline.W_RANGE = tuple(float(x) for x in wr.split("=", 1)[1].split(","))
@@ -85,6 +102,10 @@ def main(argv):
     mode = "mixed-road" if mixed else "twins-one-track" if twins else "as-is"
     if wr:
         mode = "w" + wr.split("=", 1)[1].replace(",", "-") + ("" if mode == "as-is" else "-" + mode)
+    if rf == "inverse":
+        mode = "road-inverse" + ("" if mode == "as-is" else "-" + mode)
+    if nx:
+        mode = "nmax" + nx.split("=", 1)[1] + ("" if mode == "as-is" else "-" + mode)
     for spec in argv[1:]:
         parts = spec.split(":")
         seed, scen, eff = int(parts[0]), parts[1], parts[2]
@@ -96,7 +117,7 @@ def main(argv):
             copy_without_truth(ds, blind)
         t = time.perf_counter()
         summ = diagnose(blind, work / f"{seed}-run-{mode}", workers=2, force=True, settings=dict(BLIND_SETTINGS),
-                        progress=lambda m: None)
+                        road_fit=rf, progress=lambda m: None)
         wall = time.perf_counter() - t
         det = summ.get("verdict_detail") or {}
         rank = [(e["effect"], e.get("parameters"), round(float(e.get("shrink_fraction", 0)), 3))
