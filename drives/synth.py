@@ -555,6 +555,13 @@ def bandlimited_profile(xp, zp, dx: float) -> tuple[np.ndarray, np.ndarray]:
     return xp[0] + np.arange(n) * (dxp / m), fine[:n]
 
 
+def profile_mix_weight(y, width: float):
+    """Weight a(y) of the profile p(x) in the measured-profile road at lateral position ``y`` [m]
+    (:func:`build_profile_road`: z = a p(x) + (1 - a) p(x + PROFILE_SHIFT_M)), 1 at the left edge,
+    0 at the right one of a road ``width`` [m] wide."""
+    return 0.5 + np.asarray(y, dtype=float) / float(width)
+
+
 def build_profile_road(cfg: dict, plan: dict):
     """The road of a measured profile (``[road] profile``).
 
@@ -585,7 +592,7 @@ def build_profile_road(cfg: dict, plan: dict):
     x = np.arange(int(round(length / dx)) + 1) * dx
     ny = int(round(width / dy)) + 1 if width > 0 else 1
     y = (np.arange(ny) - (ny - 1) / 2) * dy
-    a = 0.5 + y / width if width > 0 else np.ones(1)
+    a = profile_mix_weight(y, width) if width > 0 else np.ones(1)
     xf, zf = bandlimited_profile(xp, zp, dx)
     p0 = np.interp(x, xf, zf)
     p1 = np.interp(x + PROFILE_SHIFT_M, xf, zf)

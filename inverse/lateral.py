@@ -24,7 +24,6 @@ isotropic one) or a fit of ``lam`` (one drive does not resolve it).
 from __future__ import annotations
 
 import math
-import re
 
 import numpy as np
 
@@ -132,13 +131,11 @@ def twin_tyre_axles(lm) -> list:
 
 
 def fitted_axles(channels) -> list:
-    """Axle numbers of channels named ``<quantity>_<axle><side>`` (measurement format), ascending."""
-    out = set()
-    for c in channels:
-        m = re.search(r"_(\d+)[LR]$", str(c))
-        if m:
-            out.add(int(m.group(1)))
-    return sorted(out)
+    """Axle numbers of the wheel channels among ``channels`` (``drives.format.parse_channel``), ascending."""
+    from drives.format import parse_channel
+
+    parsed = (parse_channel(str(c)) for c in channels)
+    return sorted({p[1] for p in parsed if p is not None and p[2] is not None})
 
 
 #: what the twin-tyre note quotes: the independent 8x4 truck's five measured-profile drives (seeds 1-5),

@@ -28,23 +28,19 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
 
 
-def _one_track_per_side(road, model, x_start, y_offset, s, v):
-    """vehicles.simulate.road_under_tyres with each side's tyres of one axle on one track (their mean y)."""
-    vp = model.vp
-    n = s.size
-    z = np.empty((n, len(model.contacts)))
-    z_t = np.empty_like(z)
-    gx, dx = road.x, road.dx
-    ys = {}
-    for ct in model.contacts:
-        ys.setdefault((ct.axle, np.sign(ct.y)), []).append(ct.y)
-    for c, ct in enumerate(model.contacts):
-        track = road.track(y_offset + float(np.mean(ys[(ct.axle, np.sign(ct.y))])))
-        xq = x_start + vp.axles[ct.axle].x + s
-        z[:, c] = np.interp(xq, gx, track)
-        i = np.clip(((xq - gx[0]) / dx).astype(np.intp), 0, gx.size - 2)
-        z_t[:, c] = (track[i + 1] - track[i]) / dx * v
-    return z, z_t
+def _one_track_per_side(road_under_tyres):
+    """``vehicles.simulate.road_under_tyres`` with each side's tyres of one axle on one track (their mean y):
+    the original, handed the model with those tyres moved."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    def wrapped(road, model, x_start, y_offset, s, v):
+        ys = {}
+        for ct in model.contacts:
+            ys.setdefault((ct.axle, np.sign(ct.y)), []).append(ct.y)
+        moved = [replace(ct, y=float(np.mean(ys[(ct.axle, np.sign(ct.y))]))) for ct in model.contacts]
+        return road_under_tyres(road, SimpleNamespace(vp=model.vp, contacts=moved), x_start, y_offset, s, v)
+    return wrapped
 
 
 def _mixed_road_patch():
@@ -90,7 +86,7 @@ def main(argv):
         pipeline.W_RANGE = tuple(float(x) for x in wr.split("=", 1)[1].split(","))
     if twins:
         import vehicles.simulate as vs
-        vs.road_under_tyres = _one_track_per_side
+        vs.road_under_tyres = _one_track_per_side(vs.road_under_tyres)
     if mixed:
         _mixed_road_patch()
     from diagnosis.blind import BLIND_SETTINGS

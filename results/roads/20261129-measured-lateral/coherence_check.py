@@ -17,7 +17,6 @@ segment, bench_inverse.profile_scores).
 Usage: python coherence_check.py ROOT [ROOT ...]   (ROOT: a bench_inverse.py --scenario second_measured root)
 """
 import json
-import math
 import sys
 from pathlib import Path
 
@@ -27,10 +26,11 @@ import numpy as np
 def measured_structure(lm, width):
     """Cross-spectrum weights a_i a_j + (1 - a_i)(1 - a_j) of the contacts, relative to the truth track."""
     from benchmarks.bench_inverse import REF_TRACK_Y
+    from drives.synth import profile_mix_weight
     ys = np.array([c["y"] for c in lm.contacts])
-    a = 0.5 + ys / width
+    a = profile_mix_weight(ys, width)
     W = a[:, None] * a[None, :] + (1 - a[:, None]) * (1 - a[None, :])
-    at = 0.5 + REF_TRACK_Y[1] / width
+    at = profile_mix_weight(REF_TRACK_Y[1], width)
     return W / (at ** 2 + (1 - at) ** 2)
 
 

@@ -40,11 +40,14 @@ if "--linear-only" in sys.argv:     # no simulation offsets: the linear model's 
 
 
 def _measured_lines(y, grid_y):
-    """The measured-profile road's own structure: a tyre at y reads a(y) p(x) + (1 - a(y)) p(x + 40 m),
-    a = 0.5 + y / 3 m (drives.synth.build_profile_road, width 3 m), written as two 'lines' far apart
-    (p and the shifted p: unrelated, coherence 0 at 1000 m), scaled so that the fitted level is the
-    PSD of the tracks at y = +-0.93 m (the benchmark's truth, a^2 + (1 - a)^2 = 0.692 of p's)."""
-    a, at = 0.5 + y / 3.0, 0.5 + 0.93 / 3.0
+    """The measured-profile road's own structure: a tyre at y reads a(y) p(x) + (1 - a(y)) p(x + 40 m)
+    (drives.synth.profile_mix_weight, width 3 m), written as two 'lines' far apart (p and the shifted p:
+    unrelated, coherence 0 at 1000 m), scaled so that the fitted level is the PSD of the tracks at
+    benchmarks.bench_inverse.REF_TRACK_Y (the benchmark's truth, a^2 + (1 - a)^2 = 0.692 of p's)."""
+    from benchmarks.bench_inverse import REF_TRACK_Y
+    from drives.synth import profile_mix_weight
+
+    a, at = float(profile_mix_weight(y, 3.0)), float(profile_mix_weight(REF_TRACK_Y[1], 3.0))
     s = (at ** 2 + (1 - at) ** 2) ** 0.5
     return [(0.0, a / s), (1000.0, (1 - a) / s)]
 
