@@ -75,6 +75,10 @@ def main(argv=None) -> int:
     ap.add_argument("--sweep", metavar="OTHER", default=None,
                     help="set the verdict thresholds on the saved cases of --out (best of "
                          "diagnosis.blind.SWEEP_GRID) and check them on the saved cases of OTHER")
+    ap.add_argument("--band-refit", action="store_true",
+                    help="refit the road band with the ranking's first effect in the truck "
+                         "(diagnosis.pipeline.refit_band); each case keeps the first pass's "
+                         "verdict beside the final one")
     ap.add_argument("--share-min", type=float, default=None)
     ap.add_argument("--signature-max", type=float, default=None)
     ap.add_argument("--signature-share", type=float, default=None)
@@ -123,8 +127,10 @@ def main(argv=None) -> int:
     ref = reference_time()
     print(f"reference: one nominal 30 s truck simulation {ref:.2f} s", flush=True)
     t = time.perf_counter()
+    settings = {**({} if args.folds is None else {"folds": args.folds}),
+                **({"band_refit": True} if args.band_refit else {})}
     out = run_blind(args.out, args.n, seed=args.seed, workers=args.workers, duration=args.duration,
-                    settings=None if args.folds is None else {"folds": args.folds},
+                    settings=settings or None,
                     n_null=args.n if args.null_only else args.n_null, family=args.family,
                     progress=lambda m: print(m, flush=True))
     wall = time.perf_counter() - t

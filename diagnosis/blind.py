@@ -226,13 +226,35 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
                best_parameters=entry["parameters"] if entry else None,
                heldout_gap_before=float(summ["nominal"]["heldout_gap"]),
                null_sd=float(summ["nominal"]["null_gap_std"]),
-               synth_s=round(t1 - t0, 1), diagnose_s=round(t2 - t1, 1), oracle_s=round(t3 - t2, 1))
+               synth_s=round(t1 - t0, 1), diagnose_s=round(t2 - t1, 1), oracle_s=round(t3 - t2, 1),
+               band_refit=first_pass_result(case, summ))
     progress(f"case {case['case']:3d} truth {case['effect']:>16s} "
              f"{'' if case['value'] is None else format(case['value'], '.4g'):>8s} -> "
              f"{verdict:>16s} ({res['confidence']}) shrink pred {pred_shrink:.2f} "
              f"true {'-' if true_shrink is None else format(true_shrink, '.2f')}  "
              f"loc {'hit' if res['localisation_hit'] else 'miss'}  {t2 - t1:.0f} s")
     return res
+
+
+def first_pass_result(case: dict, summ: dict) -> dict | None:
+    """Where the diagnosis refitted the road band (``settings["band_refit"]``): the band before
+    and after and the first pass's verdict scored as the final one is, so one run compares
+    both rules on the same drives; None where the refit was not asked or not made."""
+    rec = (summ.get("meta") or {}).get("band_refit")
+    if not rec:
+        return None
+    out = {k: rec.get(k) for k in ("effect", "parameters", "nmax_before", "nmax_after", "changed",
+                                    "time_s", "first_pass_s")}
+    first = rec.get("first_pass")
+    if first is None:           # band unchanged: the first pass is the final one
+        verdict, conf = summ["verdict"], summ.get("verdict_confidence")
+        entry = next((e for e in summ.get("ranking", []) if e["effect"] == verdict), None)
+    else:
+        verdict, conf = first["verdict"], first.get("verdict_confidence")
+        entry = next((e for e in first.get("ranking") or [] if e["effect"] == verdict), None)
+    out.update(verdict=verdict, confidence=conf, **judge(case, verdict, conf),
+               param_ratio=param_ratio(case, entry))
+    return out
 
 
 def judge(case: dict, verdict: str, confidence) -> dict:

@@ -375,6 +375,9 @@ class TruckModel:
     #: what :func:`fit_nmax` decided about the high band, for the report: ``{"cut": [segment
     #: indices cut], "rolloff": [segment indices that roll off], "vetoed": bool}``
     high_band: dict | None = None
+    #: the inputs :func:`fit_road` gave :func:`fit_nmax` (``{"gq", "noise"}``), so that
+    #: :func:`refit_band` repeats that fit with only the effects changed
+    band_inputs: dict | None = None
 
     def __getstate__(self):
         d = dict(self.__dict__)
@@ -835,20 +838,22 @@ def _low_band_log_ratio(sig: Signals, sim: dict, mask: np.ndarray, names) -> flo
 
 
 def _record_run(args):
-    """A noise-free nominal run of the whole record with ``attrs`` set on (a copy of) the
-    model (worker side of :func:`_record_runs`)."""
-    model, attrs, T, seed, gq = args
+    """A noise-free run of the whole record with ``attrs`` set on (a copy of) the model and
+    ``effects`` in the truck (worker side of :func:`_record_runs`)."""
+    model, attrs, T, seed, gq, effects = args
     model = copy.copy(model)        # a thread pool shares the caller's model: never set it
     for name, value in attrs.items():
         setattr(model, name, value)
-    return model.run({}, 0.0, T, seed, gq=gq)
+    return model.run(effects or {}, 0.0, T, seed, gq=gq)
 
 
-def _record_runs(model: TruckModel, jobs, T: float, gq, mapper=map) -> list:
-    """Nominal whole-record runs ``jobs`` = [(attrs, seed), ...] (``attrs``: model attributes
-    such as ``nmin``, set on a copy for that run only), in parallel when ``mapper`` is an executor's
+def _record_runs(model: TruckModel, jobs, T: float, gq, mapper=map, effects=None) -> list:
+    """Whole-record runs ``jobs`` = [(attrs, seed), ...] (``attrs``: model attributes such as
+    ``nmin``, set on a copy for that run only) of the nominal truck, or of the truck with
+    ``effects`` (``{name: {param: value}}``), in parallel when ``mapper`` is an executor's
     ``map``; each run is seeded on its own, so the result does not depend on who runs it."""
-    return list(mapper(_record_run, [(model, dict(attrs), T, seed, gq) for attrs, seed in jobs]))
+    return list(mapper(_record_run, [(model, dict(attrs), T, seed, gq, effects)
+                                     for attrs, seed in jobs]))
 
 
 def fit_nmin(model: TruckModel, sig: Signals, gq, seed: int = 0, mapper=map) -> np.ndarray:
@@ -1018,7 +1023,7 @@ def choose_nmax(d: np.ndarray, e: np.ndarray, low: np.ndarray,
 
 
 def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | None = None,
-             mapper=map) -> np.ndarray:
+             mapper=map, effects=None) -> np.ndarray:
     """Highest road frequency ``nmax`` per segment, from the grid ``NMAX_GRID``.
 
     Two statistics of the axle accelerations (channels ``NMAX_QUANTITIES``, pooled; whole
@@ -1071,7 +1076,9 @@ def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | No
 
     ``diag``: if a dict, filled with ``d`` and ``e`` (rows ``NMAX_GRID``, columns segments,
     NaN where not simulated), the segments' top speeds and the high band.  ``mapper``: an
-    executor's ``map`` runs the seeds' simulations in parallel.
+    executor's ``map`` runs the seeds' simulations in parallel.  ``effects``: the simulations
+    carry these effects (``{name: {param: value}}``; default the nominal truck): the band
+    refitted with a candidate in the model (:func:`refit_band`).
     """
     fs = sig.fs
     T = sig.time.size / fs
@@ -1094,7 +1101,7 @@ def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | No
         # a neighbour's value below; left at 5 their road bled into the neighbour's window)
         nmax = np.where(todo if also is None else todo | also, NMAX_GRID[g], ROAD_NMAX)
         runs = _record_runs(model, [({"nmax": nmax}, seed + 23 * r) for r in range(NMAX_SEEDS)],
-                            T, gq, mapper)
+                            T, gq, mapper, effects=effects)
         model.nmax = nmax
         sims = [model.add_noise(sm, seed + 23 * r + 1) for r, sm in enumerate(runs)]
         for k in np.nonzero(todo)[0]:
@@ -1193,9 +1200,24 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0, mapper
     if FIT_NMIN:
         model.nmin = fit_nmin(model, sig, gq, seed, mapper=mapper)
     if FIT_NMAX:
+        model.band_inputs = {"gq": gq.copy(), "noise": dict(model.noise)}
         model.nmax = fit_nmax(model, sig, gq, seed, mapper=mapper)
+    return relevel_road(model, sig, calib_edges, gq, seed), w
+
+
+def relevel_road(model: TruckModel, sig: Signals, calib_edges, gq, seed: int = 0) -> np.ndarray:
+    """The segment levels ``gq`` [m^3] re-levelled on the calibration windows by one nominal
+    simulation of the whole record with the model's w, nmin and nmax (the last step of
+    :func:`fit_road`, and of :func:`refit_band` after the band moved)."""
+    fs = sig.fs
+    T = sig.time.size / fs
+    gq = np.array(gq, float)
+    calmask = np.zeros(sig.time.size, bool)
+    for a, b in calib_edges:
+        calmask[int(round(a * fs)):int(round(b * fs))] = True
+    skip = int(0.5 * fs)
     sim2 = model.run({}, 0.0, T, seed, gq=gq)
-    for k in range(K):
+    for k in range(len(model.bounds) - 1):
         a, b = int(round(model.bounds[k] * fs)), int(round(model.bounds[k + 1] * fs))
         mk = np.zeros_like(calmask)
         mk[min(a + skip, b):b] = True
@@ -1206,7 +1228,33 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0, mapper
         logs = _level_logs(model, sig, sim2, mk)
         if logs:
             gq[k] *= math.exp(float(np.mean(logs)))
-    return gq, w
+    return gq
+
+
+def refit_band(model: TruckModel, sig: Signals, effects, seed: int = 0, mapper=map):
+    """The road's high band refitted with ``effects`` (``{name: {param: value}}``) in the truck.
+
+    :func:`fit_nmax` compares the measured and the simulated share of 20-50 Hz axle power; an
+    effect that adds high-frequency power of its own (leaf-spring friction) makes the measured
+    share look like a road that carries power to 5 cycles/m although the road stops at 2
+    (``results/diagnosis_blind/20261129-twin-tracks/``).  Here the same fit (same levels,
+    noise and seeds as :func:`fit_road` gave it) runs with the effect in the simulations, so
+    the effect's own high band is on both sides of the comparison.  The model is not changed.
+
+    Returns
+    -------
+    (nmax, high_band, changed) : (K,) array [cycles/m], dict as ``TruckModel.high_band``,
+    bool (``nmax`` differs from the model's)
+    """
+    base = model.band_inputs or {}
+    tmp = copy.copy(model)
+    tmp.noise = dict(base.get("noise", model.noise))
+    tmp.lift_times = None           # as in fit_road: the nominal run had not been made yet
+    tmp._roads = {}
+    new = fit_nmax(tmp, sig, np.asarray(base.get("gq", model.gq), float), seed, mapper=mapper,
+                   effects=effects)
+    old = np.full(len(model.bounds) - 1, ROAD_NMAX) if model.nmax is None else np.asarray(model.nmax)
+    return new, tmp.high_band, bool(not np.array_equal(new, old))
 
 
 def candidates(names=None, vehicle=None, sides=None):
@@ -1660,6 +1708,20 @@ def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, exec
     return rec, _time.perf_counter() - t
 
 
+#: refit the road's high band with the ranking's first effect in the truck (see
+#: :func:`diagnose`, ``settings["band_refit"]``); off until a fresh blind set decides
+#: (``results/diagnosis_blind/20261129-twin-tracks/``, the stated test)
+BAND_REFIT = False
+
+
+def _report_args(ps: dict) -> dict:
+    """The keyword arguments of diagnosis.report.build_summary / write_report from one pass."""
+    return dict(localization=ps["loc"], transmissibility=ps["tr"], front_rear=ps["fr"], shape=ps["sh"],
+                ranking=ps["ranking"], signature=ps["sig_w"], transmissibility_two_input=ps["tr2"],
+                signature_two_input=ps["sig_w2"], signature_rival=ps["sig_r"],
+                signature_own=ps["sig_own"])
+
+
 def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quick: bool = False,
              force: bool = False, seed: int = 0, n_windows: int = 4, settings=None,
              road_fit: str = "levels", progress=_say) -> dict:
@@ -1694,7 +1756,11 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         runs the ranking twice with the calibration and held-out windows swapped and
         combines the two (:func:`diagnosis.which.combine_folds`; twice the time, no pairs);
         1 ranks once and tries pairs.  Budget keys: ``n_seeds``, ``n_null``, ``grid``,
-        ``refine``, ``pairs``, ``n_pair_candidates``.
+        ``refine``, ``pairs``, ``n_pair_candidates``.  ``band_refit`` (default
+        :data:`BAND_REFIT`): after the ranking, the road's high band is refitted with the
+        ranking's first effect in the truck (:func:`refit_band`); where it moves, the pass is
+        made again on the new band and ``summary["meta"]["band_refit"]`` keeps the first
+        pass's verdict.
 
     Returns
     -------
@@ -1702,7 +1768,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         The summary written to ``out/summary.json``.
     """
     from diagnosis.compare import distribution_shape, transmissibility
-    from diagnosis.report import write_report
+    from diagnosis.report import build_summary, write_report
     from diagnosis.verdict import SIGNATURE_METHOD, own_statistic, search_ranges
     from diagnosis.which import combine_folds, rank_effects
     from diagnosis.where import localize
@@ -1725,19 +1791,12 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                                    if "resampled_from_hz" in sig.meta else ""))
     # one pool for the road fit, the ranking and the signatures; shut down however it ends
     ex = process_pool(workers) if workers and workers > 1 else None
-    try:
-        ctx = prepare(sig, veh, seed=seed, n_windows=n_windows, road_fit=road_fit, workers=workers,
-                      executor=ex)
-        model, calib, held, edges, bounds = ctx.model, ctx.calib, ctx.held, ctx.edges, ctx.bounds
-        cal_edges, simc, segs = ctx.cal_edges, ctx.sim_nominal, ctx.segs
-        timing["road_fit_s"] = ctx.road_fit_s
-        progress(f"road: {len(bounds) - 1} segment(s), Gq(n0) = "
-                 + ", ".join(f"{g * 1e6:.3g}" for g in model.gq) + " x 1e-6 m^3, w = "
-                 + ", ".join(f"{x:.2f}" for x in model.w)
-                 + "".join(f", {lab} = " + ", ".join(f"{x:g}" for x in v)
-                           for lab, v in (("nmin", model.nmin), ("nmax", model.nmax)) if v is not None)
-                 + " (calibration windows)")
+    settings = dict(settings or {})
+    band_refit = bool(settings.pop("band_refit", BAND_REFIT))
+    T = sig.time.size / sig.fs
 
+    def one_pass(model, simc):
+        """Localisation, ranking and signatures on the model's road (one pass)."""
         # where: nominal over the whole record
         t = _time.perf_counter()
         T = sig.time.size / sig.fs
@@ -1809,50 +1868,106 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                                             entry=rival)
             sig_r = {"effect": rival.effect, "single_input": r1, "two_input": r2}
             timing["signature_rival_s"] = t_r
+        return dict(loc=loc, tr=tr, tr2=tr2, fr=fr, sh=sh, ranking=ranking, sig_w=sig_w,
+                    sig_w2=sig_w2, sig_r=sig_r, sig_own=sig_own, cands=cands, side_rec=side_rec,
+                    kw=kw, folds=folds, wheelbase=wheelbase, sim=sim)
+
+    def make_meta(model, ps, band_refit_record):
+        cands, side_rec, kw, folds = ps['cands'], ps['side_rec'], ps['kw'], ps['folds']
+        wheelbase = ps['wheelbase']
+        T = sig.time.size / sig.fs
+        meta = {
+            "dataset": os.path.relpath(Path(dataset).resolve(), out.resolve()),
+            "dataset_name": drive.name, "vehicle": str(vp.id),
+            # record time of the first sample: every *_s window and segment time in this summary
+            # counts from that sample; the report adds this to show record times (as Table 1)
+            "record_t0_s": float(np.asarray(drive.time, float)[0]),
+            "duration_s": float(T), "channels": list(sig.channels),
+            "sample_rate_hz": float(sig.fs), "resampled_from_hz": sig.meta.get("resampled_from_hz"),
+            "road_segments": [{"segment": s[0], "t_start_s": s[1], "t_end_s": s[2],
+                               "Gq_n0_m3": float(model.gq[k]), "w": float(model.w[k]),
+                               "nmin": float(ROAD_NMIN if model.nmin is None else model.nmin[k]),
+                               "nmax": float(ROAD_NMAX if model.nmax is None else model.nmax[k])}
+                              for k, s in enumerate(segs)],
+            "road_w_range": list(W_RANGE) if road_fit == "levels" else None,
+            "road_high_band": (None if model.high_band is None else
+                               {"cut": [segs[k][0] for k in model.high_band["cut"]],
+                                "rolloff": [segs[k][0] for k in model.high_band["rolloff"]],
+                                "vetoed": model.high_band["vetoed"]}),
+            "road_fit": ("segment level and waviness from the nominal model on the calibration "
+                         "windows" if road_fit == "levels" else
+                         "inverse.pipeline.invert on the whole record (nominal truck)")
+            + "; level re-profiled per segment piece for every model and window",
+            "split": f"{n_windows} equal time windows; odd windows calibrate, even windows held out"
+            + ("; then the other way round (two folds, combined)" if folds == 2 else ""),
+            "calibration_windows_s": [list(map(float, e)) for e in cal_edges],
+            "heldout_windows_s": [[float(edges[i]), float(edges[i + 1])] for i in range(n_windows)
+                                  if i % 2 == 1],
+            "noise_std": model.noise, "wheelbase_m": wheelbase, "quick": bool(quick), "seed": int(seed),
+            "workers": int(workers), "candidates": [c.name for c in cands],
+            "search_ranges": search_ranges(cands),
+            "own_side": side_rec,
+            "signature_method": SIGNATURE_METHOD,
+            "ranking_settings": {**{k: v for k, v in kw.items()}, "folds": folds},
+            "timing": {k: round(v, 2) for k, v in timing.items()},
+            "band_refit": band_refit_record,
+        }
+        return meta
+
+    try:
+        ctx = prepare(sig, veh, seed=seed, n_windows=n_windows, road_fit=road_fit, workers=workers,
+                      executor=ex)
+        model, calib, held, edges, bounds = ctx.model, ctx.calib, ctx.held, ctx.edges, ctx.bounds
+        cal_edges, simc, segs = ctx.cal_edges, ctx.sim_nominal, ctx.segs
+        timing["road_fit_s"] = ctx.road_fit_s
+        progress(f"road: {len(bounds) - 1} segment(s), Gq(n0) = "
+                 + ", ".join(f"{g * 1e6:.3g}" for g in model.gq) + " x 1e-6 m^3, w = "
+                 + ", ".join(f"{x:.2f}" for x in model.w)
+                 + "".join(f", {lab} = " + ", ".join(f"{x:g}" for x in v)
+                           for lab, v in (("nmin", model.nmin), ("nmax", model.nmax)) if v is not None)
+                 + " (calibration windows)")
+
+        ps = one_pass(model, simc)
+        refit = None
+        if band_refit and ps['ranking'].gap_present and ps['ranking'].entries:
+            # the road's high band refitted with the closest effect in the truck (refit_band);
+            # where it moves, the whole pass is made again on the new band and the first
+            # pass's verdict is kept in the record
+            t = _time.perf_counter()
+            first_pass_s = t - wall0        # what the diagnosis took without the refit
+            top = ps['ranking'].entries[0]
+            nmax_before = (np.full(len(bounds) - 1, ROAD_NMAX) if model.nmax is None
+                           else np.asarray(model.nmax, float))
+            new, high_band, changed = refit_band(model, sig, top.effects, seed,
+                                                 mapper=ex.map if ex is not None else map)
+            refit = {'effect': top.effect, 'parameters': top.effects,
+                     'nmax_before': [float(x) for x in nmax_before],
+                     'nmax_after': [float(x) for x in new], 'changed': changed,
+                     'first_pass_s': round(first_pass_s, 2)}
+            if changed:
+                first = build_summary(**_report_args(ps), meta=make_meta(model, ps, None))
+                refit['first_pass'] = {k: first.get(k) for k in ('verdict', 'verdict_confidence',
+                                                                  'verdict_reason', 'ranking')}
+                refit['first_pass']['Gq_n0_m3'] = [float(g) for g in model.gq]
+                model.nmax, model.high_band = new, high_band
+                model.gq = relevel_road(model, sig, cal_edges, model.gq, seed)
+                model.lift_times = None
+                simc, model.lift_times = model.run({}, 0.0, T, seed + 1, with_lift_times=True)
+                model.noise = noise_from_residual(sig, simc)
+                progress(f"road band refitted with {top.effect} in the truck: nmax = "
+                         + ', '.join(f'{x:g}' for x in new) + f" (was "
+                         + ', '.join(f'{x:g}' for x in nmax_before) + '); the ranking again on it')
+                refit['first_pass']['timing'] = {k: round(v, 2) for k, v in timing.items()}
+                ps = one_pass(model, simc)
+            refit['time_s'] = round(_time.perf_counter() - t, 2)
+            timing['band_refit_s'] = refit['time_s']
     finally:
         if ex is not None:
             ex.shutdown()
     timing["total_s"] = _time.perf_counter() - wall0
 
-    meta = {
-        "dataset": os.path.relpath(Path(dataset).resolve(), out.resolve()),
-        "dataset_name": drive.name, "vehicle": str(vp.id),
-        # record time of the first sample: every *_s window and segment time in this summary
-        # counts from that sample; the report adds this to show record times (as Table 1)
-        "record_t0_s": float(np.asarray(drive.time, float)[0]),
-        "duration_s": float(T), "channels": list(sig.channels),
-        "sample_rate_hz": float(sig.fs), "resampled_from_hz": sig.meta.get("resampled_from_hz"),
-        "road_segments": [{"segment": s[0], "t_start_s": s[1], "t_end_s": s[2],
-                           "Gq_n0_m3": float(model.gq[k]), "w": float(model.w[k]),
-                           "nmin": float(ROAD_NMIN if model.nmin is None else model.nmin[k]),
-                           "nmax": float(ROAD_NMAX if model.nmax is None else model.nmax[k])}
-                          for k, s in enumerate(segs)],
-        "road_w_range": list(W_RANGE) if road_fit == "levels" else None,
-        "road_high_band": (None if model.high_band is None else
-                           {"cut": [segs[k][0] for k in model.high_band["cut"]],
-                            "rolloff": [segs[k][0] for k in model.high_band["rolloff"]],
-                            "vetoed": model.high_band["vetoed"]}),
-        "road_fit": ("segment level and waviness from the nominal model on the calibration "
-                     "windows" if road_fit == "levels" else
-                     "inverse.pipeline.invert on the whole record (nominal truck)")
-        + "; level re-profiled per segment piece for every model and window",
-        "split": f"{n_windows} equal time windows; odd windows calibrate, even windows held out"
-        + ("; then the other way round (two folds, combined)" if folds == 2 else ""),
-        "calibration_windows_s": [list(map(float, e)) for e in cal_edges],
-        "heldout_windows_s": [[float(edges[i]), float(edges[i + 1])] for i in range(n_windows)
-                              if i % 2 == 1],
-        "noise_std": model.noise, "wheelbase_m": wheelbase, "quick": bool(quick), "seed": int(seed),
-        "workers": int(workers), "candidates": [c.name for c in cands],
-        "search_ranges": search_ranges(cands),
-        "own_side": side_rec,
-        "signature_method": SIGNATURE_METHOD,
-        "ranking_settings": {**{k: v for k, v in kw.items()}, "folds": folds},
-        "timing": {k: round(v, 2) for k, v in timing.items()},
-    }
-    write_report(out, localization=loc, transmissibility=tr, front_rear=fr, shape=sh,
-                 ranking=ranking, meta=meta, force=force, signature=sig_w,
-                 transmissibility_two_input=tr2, signature_two_input=sig_w2,
-                 signature_rival=sig_r, signature_own=sig_own)
+    meta = make_meta(model, ps, refit)
+    write_report(out, **_report_args(ps), meta=meta, force=force)
     write_run_json(out, finish_run_info(record, "complete", wall_s=_time.perf_counter() - wall0))
     summary = json.loads((out / "summary.json").read_text())
     progress(f"verdict: {summary['verdict']} ({summary['verdict_confidence']}); "
