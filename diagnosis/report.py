@@ -728,6 +728,16 @@ def _road_text(summary: Mapping) -> list:
     elif hb.get("rolloff"):
         L.append("\nThe measured high band rolls off in " + ", ".join(hb["rolloff"])
                  + " (no cut): left to the candidates (tyre enveloping, a sensor low-pass).")
+    br = meta.get("band_refit") or {}
+    if br.get("changed"):
+        first = br.get("first_pass") or {}
+        L.append(f"\nBand refitted with {br['effect']} in the truck (its first-pass calibration): "
+                 "nmax moved from " + ", ".join(f"{x:g}" for x in br["nmax_before"]) + " to "
+                 + ", ".join(f"{x:g}" for x in br["nmax_after"]) + " cycles/m, and everything "
+                 "above was made again on the new band. On the nominal model's band the verdict "
+                 f"was {first.get('verdict')} ({first.get('verdict_confidence')}).")
+    elif br:
+        L.append(f"\nBand refitted with {br['effect']} in the truck: unchanged.")
     L.append("")
     return L
 
