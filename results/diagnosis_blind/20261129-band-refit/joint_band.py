@@ -12,7 +12,8 @@ Sources (no new simulation here):
   * cut band: twin_check.py --nmax=2 records (same form).
 A difference below 1 % is "same" (the two diagnoses ran the same band).
 
-Usage: python joint_band.py    (prints one line per drive and the counts)
+Usage: python joint_band.py [--fresh]   (one line per drive and the counts; --fresh: the 18 drives
+of this folder's fresh set, first pass against records/fresh/, stated in decision.txt before it ran)
 """
 import json
 from pathlib import Path
@@ -44,10 +45,32 @@ def fitted_from_share():
     return out
 
 
-def main():
-    share = fitted_from_share()
+def fitted_from_fresh(folder):
+    """The fresh set of this folder: the first pass (today's rules) of each drive; where the
+    band refit made a second pass, the first pass's ranking kept in meta.band_refit."""
+    out = {}
+    for r in json.loads((folder / "blind.json").read_text())["results"]:
+        s = json.loads((folder / f"case{r['case']:03d}-summary.json").read_text())
+        first = (s["meta"].get("band_refit") or {}).get("first_pass")
+        ranking = first["ranking"] if first else s["ranking"]
+        verdict = first["verdict"] if first else s["verdict"]
+        before = float(ranking[0]["heldout_gap_before"]) if ranking else float(s["nominal"]["heldout_gap"])
+        best = min(ranking, key=lambda e: e["heldout_gap_after"])
+        out[int(r["seed"])] = dict(truth=r["effect"], value=r["value"], scenario=r["scenario"],
+                                   nominal=before, best=best["effect"],
+                                   best_gap=float(best["heldout_gap_after"]), verdict=verdict)
+    return out
+
+
+def main(fresh=False):
+    """``fresh``: the 18 drives of this folder's fresh set (records/fresh/), else the 23 before."""
+    if fresh:
+        share, cuts = fitted_from_fresh(HERE / "second"), sorted((HERE / "records" / "fresh").glob("*-nmax2.json"))
+    else:
+        share = fitted_from_share()
+        cuts = sorted((HERE / "records").glob("*-nmax2.json")) + sorted(TWIN.glob("*-nmax2.json"))
     rows = []
-    for cut in sorted((HERE / "records").glob("*-nmax2.json")) + sorted(TWIN.glob("*-nmax2.json")):
+    for cut in cuts:
         seed = int(cut.name.split("-")[0])
         c = from_record(cut)
         as_is = [p for p in (HERE / "records" / f"{seed}-as-is.json", TWIN / f"{seed}-as-is.json") if p.is_file()]
@@ -71,4 +94,6 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    main(fresh="--fresh" in sys.argv[1:])
