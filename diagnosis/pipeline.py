@@ -1709,8 +1709,10 @@ def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, exec
 
 
 #: refit the road's high band with the ranking's first effect in the truck (see
-#: :func:`diagnose`, ``settings["band_refit"]``); off until a fresh blind set decides
-#: (``results/diagnosis_blind/20261129-twin-tracks/``, the stated test)
+#: :func:`diagnose`, ``settings["band_refit"]``).  Off: it failed its stated test on a fresh
+#: independent-truck set (right names 9/9 -> 8/9; the effect calibrated on the wrong band is too
+#: weak to show the cut), ``results/diagnosis_blind/20261129-band-refit/``; kept for that folder's
+#: command and as the record of what was tried.
 BAND_REFIT = False
 
 
