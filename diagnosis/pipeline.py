@@ -1231,6 +1231,12 @@ def relevel_road(model: TruckModel, sig: Signals, calib_edges, gq, seed: int = 0
     return gq
 
 
+def model_nmax(model: TruckModel) -> np.ndarray:
+    """The model's nmax per segment [cycles/m], ``ROAD_NMAX`` where it was not fitted."""
+    K = len(model.bounds) - 1
+    return np.full(K, float(ROAD_NMAX)) if model.nmax is None else np.asarray(model.nmax, float)
+
+
 def refit_band(model: TruckModel, sig: Signals, effects, seed: int = 0, mapper=map):
     """The road's high band refitted with ``effects`` (``{name: {param: value}}``) in the truck.
 
@@ -1253,8 +1259,7 @@ def refit_band(model: TruckModel, sig: Signals, effects, seed: int = 0, mapper=m
     tmp._roads = {}
     new = fit_nmax(tmp, sig, np.asarray(base.get("gq", model.gq), float), seed, mapper=mapper,
                    effects=effects)
-    old = np.full(len(model.bounds) - 1, ROAD_NMAX) if model.nmax is None else np.asarray(model.nmax)
-    return new, tmp.high_band, bool(not np.array_equal(new, old))
+    return new, tmp.high_band, bool(not np.array_equal(new, model_nmax(model)))
 
 
 def candidates(names=None, vehicle=None, sides=None):
@@ -1367,12 +1372,20 @@ def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fi
                                      mapper=executor.map if executor is not None else map)
     else:
         raise EroadInputError(f"road_fit must be 'levels' or 'inverse', got {road_fit!r}")
-    T = sig.time.size / sig.fs
-    simc, model.lift_times = model.run({}, 0.0, T, seed + 1, with_lift_times=True)
-    model.noise = noise_from_residual(sig, simc)
+    simc = nominal_record(model, sig, seed)
     segs = [(f"S{k + 1}", float(bounds[k]), float(bounds[k + 1])) for k in range(len(bounds) - 1)]
     return Context(model, calib, held, edges, bounds, cal_edges, simc, segs,
                    _time.perf_counter() - t)
+
+
+def nominal_record(model: TruckModel, sig: Signals, seed: int = 0) -> dict:
+    """The nominal simulation of the whole record on the model's road (road-phase seed
+    ``seed + 1``, noise-free), setting the model's lift-off times and its noise floor from the
+    residual (the last step of :func:`prepare`, and of a band refit in :func:`diagnose`)."""
+    model.lift_times = None         # the run that finds them takes no hint from earlier ones
+    simc, model.lift_times = model.run({}, 0.0, sig.time.size / sig.fs, seed + 1, with_lift_times=True)
+    model.noise = noise_from_residual(sig, simc)
+    return simc
 
 
 def front_rear_or_none(sig, sim, **kw):
@@ -1795,13 +1808,12 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     ex = process_pool(workers) if workers and workers > 1 else None
     settings = dict(settings or {})
     band_refit = bool(settings.pop("band_refit", BAND_REFIT))
-    T = sig.time.size / sig.fs
+    T = sig.time.size / sig.fs      # record length [s]
 
     def one_pass(model, simc):
         """Localisation, ranking and signatures on the model's road (one pass)."""
         # where: nominal over the whole record
         t = _time.perf_counter()
-        T = sig.time.size / sig.fs
         sim = Signals(sig.time, model.add_noise(simc, seed + 1), dict(sig.units), sig.speed,
                       {"model": "nominal"})
         loc = localize(sig, sim, segments=segs)
@@ -1872,12 +1884,11 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
             timing["signature_rival_s"] = t_r
         return dict(loc=loc, tr=tr, tr2=tr2, fr=fr, sh=sh, ranking=ranking, sig_w=sig_w,
                     sig_w2=sig_w2, sig_r=sig_r, sig_own=sig_own, cands=cands, side_rec=side_rec,
-                    kw=kw, folds=folds, wheelbase=wheelbase, sim=sim)
+                    kw=kw, folds=folds, wheelbase=wheelbase)
 
     def make_meta(model, ps, band_refit_record):
         cands, side_rec, kw, folds = ps['cands'], ps['side_rec'], ps['kw'], ps['folds']
         wheelbase = ps['wheelbase']
-        T = sig.time.size / sig.fs
         meta = {
             "dataset": os.path.relpath(Path(dataset).resolve(), out.resolve()),
             "dataset_name": drive.name, "vehicle": str(vp.id),
@@ -1889,7 +1900,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
             "road_segments": [{"segment": s[0], "t_start_s": s[1], "t_end_s": s[2],
                                "Gq_n0_m3": float(model.gq[k]), "w": float(model.w[k]),
                                "nmin": float(ROAD_NMIN if model.nmin is None else model.nmin[k]),
-                               "nmax": float(ROAD_NMAX if model.nmax is None else model.nmax[k])}
+                               "nmax": float(model_nmax(model)[k])}
                               for k, s in enumerate(segs)],
             "road_w_range": list(W_RANGE) if road_fit == "levels" else None,
             "road_high_band": (None if model.high_band is None else
@@ -1938,8 +1949,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
             t = _time.perf_counter()
             first_pass_s = t - wall0        # what the diagnosis took without the refit
             top = ps['ranking'].entries[0]
-            nmax_before = (np.full(len(bounds) - 1, ROAD_NMAX) if model.nmax is None
-                           else np.asarray(model.nmax, float))
+            nmax_before = model_nmax(model)
             new, high_band, changed = refit_band(model, sig, top.effects, seed,
                                                  mapper=ex.map if ex is not None else map)
             refit = {'effect': top.effect, 'parameters': top.effects,
@@ -1953,9 +1963,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                 refit['first_pass']['Gq_n0_m3'] = [float(g) for g in model.gq]
                 model.nmax, model.high_band = new, high_band
                 model.gq = relevel_road(model, sig, cal_edges, model.gq, seed)
-                model.lift_times = None
-                simc, model.lift_times = model.run({}, 0.0, T, seed + 1, with_lift_times=True)
-                model.noise = noise_from_residual(sig, simc)
+                simc = nominal_record(model, sig, seed)
                 progress(f"road band refitted with {top.effect} in the truck: nmax = "
                          + ', '.join(f'{x:g}' for x in new) + f" (was "
                          + ', '.join(f'{x:g}' for x in nmax_before) + '); the ranking again on it')
