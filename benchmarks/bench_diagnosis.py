@@ -79,6 +79,10 @@ def main(argv=None) -> int:
                     help="refit the road band with the ranking's first effect in the truck "
                          "(diagnosis.pipeline.refit_band); each case keeps the first pass's "
                          "verdict beside the final one")
+    ap.add_argument("--joint-band", action="store_true",
+                    help="choose the road band jointly with the effect (diagnosis.pipeline."
+                         "JOINT_BAND): a second pass on a road cut where the measured spectrum "
+                         "steps down; each case keeps the first pass's verdict beside the final one")
     ap.add_argument("--share-min", type=float, default=None)
     ap.add_argument("--signature-max", type=float, default=None)
     ap.add_argument("--signature-share", type=float, default=None)
@@ -128,7 +132,8 @@ def main(argv=None) -> int:
     print(f"reference: one nominal 30 s truck simulation {ref:.2f} s", flush=True)
     t = time.perf_counter()
     settings = {**({} if args.folds is None else {"folds": args.folds}),
-                **({"band_refit": True} if args.band_refit else {})}
+                **({"band_refit": True} if args.band_refit else {}),
+                **({"joint_band": True} if args.joint_band else {})}
     out = run_blind(args.out, args.n, seed=args.seed, workers=args.workers, duration=args.duration,
                     settings=settings or None,
                     n_null=args.n if args.null_only else args.n_null, family=args.family,

@@ -227,7 +227,8 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
                heldout_gap_before=float(summ["nominal"]["heldout_gap"]),
                null_sd=float(summ["nominal"]["null_gap_std"]),
                synth_s=round(t1 - t0, 1), diagnose_s=round(t2 - t1, 1), oracle_s=round(t3 - t2, 1),
-               band_refit=first_pass_result(case, summ))
+               band_refit=first_pass_result(case, summ),
+               joint_band=first_pass_result(case, summ, "joint_band"))
     progress(f"case {case['case']:3d} truth {case['effect']:>16s} "
              f"{'' if case['value'] is None else format(case['value'], '.4g'):>8s} -> "
              f"{verdict:>16s} ({res['confidence']}) shrink pred {pred_shrink:.2f} "
@@ -236,15 +237,17 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
     return res
 
 
-def first_pass_result(case: dict, summ: dict) -> dict | None:
-    """Where the diagnosis refitted the road band (``settings["band_refit"]``): the band before
+def first_pass_result(case: dict, summ: dict, key: str = "band_refit") -> dict | None:
+    """Where the diagnosis made a second pass on another road band (``key``: ``"band_refit"``,
+    ``settings["band_refit"]``, or ``"joint_band"``, ``settings["joint_band"]``): the band before
     and after and the first pass's verdict scored as the final one is, so one run compares
-    both rules on the same drives; None where the refit was not asked or not made."""
-    rec = (summ.get("meta") or {}).get("band_refit")
+    both rules on the same drives; None where the option was not asked or not run."""
+    rec = (summ.get("meta") or {}).get(key)
     if not rec:
         return None
     out = {k: rec.get(k) for k in ("effect", "parameters", "nmax_before", "nmax_after", "changed",
-                                    "time_s", "first_pass_s")}
+                                    "time_s", "first_pass_s", "trial_cut", "step", "gap_fitted",
+                                    "gap_cut", "chosen") if k in rec}
     first = rec.get("first_pass")
     if first is None:           # band unchanged: the first pass is the final one
         verdict, conf = summ["verdict"], summ.get("verdict_confidence")

@@ -1727,6 +1727,22 @@ def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, exec
 #: weak to show the cut), ``results/diagnosis_blind/20261129-band-refit/``; kept for that folder's
 #: command and as the record of what was tried.
 BAND_REFIT = False
+#: the road's band chosen jointly with the effect (``diagnose(settings={"joint_band": ...})``):
+#: where the measured axle spectrum steps down at a spatial frequency (``diagnosis.band_edge``)
+#: and the first pass found a gap, the whole pass is made again on a road cut there, and the
+#: pass whose best model (nominal or ranked) reaches the lower held-out gap is reported; the cut
+#: must win by ``JOINT_BAND_MARGIN`` (its gap below that fraction of the fitted band's).  Stop 56
+#: read 0.36-0.60 (and 0.45, 0.82 fresh) on measured-profile friction drives, 1.21-31 on
+#: full-band drives and one tie (1.00): results/diagnosis_blind/20261129-band-refit/
+JOINT_BAND = False
+JOINT_BAND_MARGIN = 0.9
+
+
+def best_heldout_gap(ranking) -> float:
+    """The lowest held-out gap a pass reaches: the nominal model's or any ranked model's (mean
+    over seeds, as ``summary.json`` reports them)."""
+    gaps = [float(np.mean(ranking.before))] + [float(np.mean(e.after)) for e in ranking.entries]
+    return float(min(gaps))
 
 
 def _report_args(ps: dict) -> dict:
@@ -1775,13 +1791,19 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         :data:`BAND_REFIT`): after the ranking, the road's high band is refitted with the
         ranking's first effect in the truck (:func:`refit_band`); where it moves, the pass is
         made again on the new band and ``summary["meta"]["band_refit"]`` keeps the first
-        pass's verdict.
+        pass's verdict.  ``joint_band`` (default :data:`JOINT_BAND`): where a gap is present and
+        the measured axle spectrum steps down at a spatial frequency below the fitted band's top
+        (:func:`diagnosis.band_edge.trial_cut`), the pass is made again on a road cut there and
+        the pass whose best model reaches the lower held-out gap (the cut by
+        :data:`JOINT_BAND_MARGIN`) is reported; ``summary["meta"]["joint_band"]`` keeps the
+        other pass's verdict and ranking.
 
     Returns
     -------
     dict
         The summary written to ``out/summary.json``.
     """
+    from diagnosis.band_edge import trial_cut
     from diagnosis.compare import distribution_shape, transmissibility
     from diagnosis.report import build_summary, write_report
     from diagnosis.verdict import SIGNATURE_METHOD, own_statistic, search_ranges
@@ -1808,6 +1830,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     ex = process_pool(workers) if workers and workers > 1 else None
     settings = dict(settings or {})
     band_refit = bool(settings.pop("band_refit", BAND_REFIT))
+    joint_band = bool(settings.pop("joint_band", JOINT_BAND))
     T = sig.time.size / sig.fs      # record length [s]
 
     def one_pass(model, simc):
@@ -1886,7 +1909,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                     sig_w2=sig_w2, sig_r=sig_r, sig_own=sig_own, cands=cands, side_rec=side_rec,
                     kw=kw, folds=folds, wheelbase=wheelbase)
 
-    def make_meta(model, ps, band_refit_record):
+    def make_meta(model, ps, band_refit_record, joint_record=None):
         cands, side_rec, kw, folds = ps['cands'], ps['side_rec'], ps['kw'], ps['folds']
         wheelbase = ps['wheelbase']
         meta = {
@@ -1924,6 +1947,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
             "ranking_settings": {**{k: v for k, v in kw.items()}, "folds": folds},
             "timing": {k: round(v, 2) for k, v in timing.items()},
             "band_refit": band_refit_record,
+            "joint_band": joint_record,
         }
         return meta
 
@@ -1941,7 +1965,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                  + " (calibration windows)")
 
         ps = one_pass(model, simc)
-        refit = None
+        refit = joint = None
         if band_refit and ps['ranking'].gap_present and ps['ranking'].entries:
             # the road's high band refitted with the closest effect in the truck (refit_band);
             # where it moves, the whole pass is made again on the new band and the first
@@ -1971,12 +1995,58 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                 ps = one_pass(model, simc)
             refit['time_s'] = round(_time.perf_counter() - t, 2)
             timing['band_refit_s'] = refit['time_s']
+        joint = None
+        if joint_band and ps['ranking'].gap_present:
+            # the band chosen with the effect: a cut where the measured spectrum steps down in
+            # spatial frequency (diagnosis.band_edge), the whole pass made on it, the pass whose
+            # best model reaches the lower held-out gap kept (JOINT_BAND_MARGIN)
+            t = _time.perf_counter()
+            tc = trial_cut(sig, NMAX_GRID, ROAD_NMAX)
+            before = model_nmax(model)
+            joint = {'step': {f'{g:g}': v for g, v in tc['step'].items()}, 'trial_cut': tc['cut'],
+                     'threshold': tc['threshold'], 'windows': tc['windows'],
+                     'nmax_before': [float(x) for x in before], 'margin': JOINT_BAND_MARGIN,
+                     'first_pass_s': round(t - wall0, 2), 'chosen': 'fitted'}
+            if tc['cut'] is not None and np.any(before > tc['cut']):
+                first = build_summary(**_report_args(ps), meta=make_meta(model, ps, refit))
+                kept = (model.nmax, model.high_band, model.gq, model.lift_times, model.noise, simc,
+                        dict(timing))
+                new = np.minimum(before, tc['cut'])
+                model.nmax = new
+                model.high_band = {"cut": [int(k) for k in np.nonzero(new < ROAD_NMAX)[0]],
+                                   "rolloff": [], "vetoed": False}
+                model.gq = relevel_road(model, sig, cal_edges, model.gq, seed)
+                simc = nominal_record(model, sig, seed)
+                progress(f"measured axle spectrum steps down at {tc['cut']:g} cycles/m: the pass "
+                         f"again on a road cut there")
+                ps_cut = one_pass(model, simc)
+                g_fit, g_cut = best_heldout_gap(ps['ranking']), best_heldout_gap(ps_cut['ranking'])
+                joint.update(nmax_after=[float(x) for x in new], gap_fitted=round(g_fit, 4),
+                             gap_cut=round(g_cut, 4))
+                if g_cut < JOINT_BAND_MARGIN * g_fit:
+                    joint['chosen'] = 'cut'
+                    joint['first_pass'] = {k: first.get(k) for k in ('verdict', 'verdict_confidence',
+                                                                      'verdict_reason', 'ranking')}
+                    joint['first_pass']['Gq_n0_m3'] = [float(g) for g in kept[2]]
+                    joint['first_pass']['timing'] = {k: round(v, 2) for k, v in kept[6].items()}
+                    ps = ps_cut
+                else:
+                    cut = build_summary(**_report_args(ps_cut), meta=make_meta(model, ps_cut, refit))
+                    joint['cut_pass'] = {k: cut.get(k) for k in ('verdict', 'verdict_confidence',
+                                                                  'verdict_reason', 'ranking')}
+                    model.nmax, model.high_band, model.gq, model.lift_times, model.noise, simc = kept[:6]
+                    timing.clear()
+                    timing.update(kept[6])
+                progress(f"band: held-out gap {g_fit:.3g} on the fitted band, {g_cut:.3g} on the cut "
+                         f"(margin {JOINT_BAND_MARGIN:g}): the {joint['chosen']} band's pass reported")
+            joint['time_s'] = round(_time.perf_counter() - t, 2)
+            timing['joint_band_s'] = joint['time_s']
     finally:
         if ex is not None:
             ex.shutdown()
     timing["total_s"] = _time.perf_counter() - wall0
 
-    meta = make_meta(model, ps, refit)
+    meta = make_meta(model, ps, refit, joint)
     write_report(out, **_report_args(ps), meta=meta, force=force)
     write_run_json(out, finish_run_info(record, "complete", wall_s=_time.perf_counter() - wall0))
     summary = json.loads((out / "summary.json").read_text())

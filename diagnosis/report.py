@@ -738,6 +738,26 @@ def _road_text(summary: Mapping) -> list:
                  f"was {first.get('verdict')} ({first.get('verdict_confidence')}).")
     elif br:
         L.append(f"\nBand refitted with {br['effect']} in the truck: unchanged.")
+    jb = meta.get("joint_band") or {}
+    if jb.get("gap_cut") is not None:
+        other = jb.get("first_pass") or jb.get("cut_pass") or {}
+        L.append(f"\nThe measured axle accelerations step down at {jb['trial_cut']:g} cycles/m in "
+                 f"spatial frequency (step {jb['step'].get(format(jb['trial_cut'], 'g'))}, trigger "
+                 f"{jb['threshold']:g}), as on a road that stops there (a replica of a profile "
+                 "sampled every 1 / (2 x that) m). The whole diagnosis was made on the fitted band "
+                 f"and on a road cut there: the best model's held-out gap {jb['gap_fitted']:.3g} "
+                 f"against {jb['gap_cut']:.3g}; the cut band is taken only below "
+                 f"{jb['margin']:g} x the fitted one's, so this report is the "
+                 f"{jb['chosen']} band's. On the other band the verdict was "
+                 f"{other.get('verdict')} ({other.get('verdict_confidence')}).")
+    elif jb.get("trial_cut") is not None:
+        L.append(f"\nThe measured axle accelerations step down at {jb['trial_cut']:g} cycles/m in "
+                 "spatial frequency; the fitted band already stops there or below.")
+    elif jb:
+        L.append("\nNo step in the measured axle spectrum below the fitted band's top"
+                 + (f" (largest {max(v for v in jb['step'].values() if v is not None):.2f}, trigger "
+                    f"{jb['threshold']:g})" if any(v is not None for v in jb['step'].values()) else "")
+                 + ": the road band was not tried lower.")
     L.append("")
     return L
 
