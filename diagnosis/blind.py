@@ -260,6 +260,45 @@ def first_pass_result(case: dict, summ: dict, key: str = "band_refit") -> dict |
     return out
 
 
+def two_rule_counts(results: list[dict], key: str, which: str = "final") -> dict:
+    """Counts of one rule on cases scored by :func:`run_case`: ``which`` "final" (the verdict
+    reported) or "first" (the first pass kept under ``key``, :func:`first_pass_result`; where it
+    is absent the first pass was the final one).  Keys: ``named`` (library cases named right),
+    ``library``, ``no_effect_right``, ``no_effect``, ``wrong`` (an effect named that is not the
+    truth's), ``clear_wrong``, ``within_1p5`` (values within x1.5 among right names with a
+    value), ``valued``."""
+    def get(r):
+        f = r.get(key) if which == "first" else None
+        f = f or r
+        return f["verdict"], f["correct"], f["confident_wrong"], f.get("param_ratio")
+    g = [(r, get(r)) for r in results]
+    lib = [x for r, x in g if r["effect"] != "none"]
+    nul = [x for r, x in g if r["effect"] == "none"]
+    vals = [x[3] for x in lib if x[1] and x[3] is not None]
+    return {"named": sum(x[1] for x in lib), "library": len(lib),
+            "no_effect_right": sum(x[1] for x in nul), "no_effect": len(nul),
+            "wrong": sum(1 for r, x in g if x[0] not in ("none", "unexplained") and x[0] != r["effect"]),
+            "clear_wrong": sum(x[2] for _, x in g),
+            "within_1p5": sum(1 for v in vals if 1 / 1.5 <= v <= 1.5), "valued": len(vals)}
+
+
+def two_rule_lines(results: list[dict], key: str) -> tuple[list[str], list[str]]:
+    """The first pass (kept under ``key``) against the final verdict, as text: the counts of
+    :func:`two_rule_counts` per rule, and the time per diagnosis per rule (the first pass's is
+    the whole diagnosis less the second pass's ``time_s``)."""
+    score = []
+    for lab, which in (("first pass", "first"), ("final", "final")):
+        c = two_rule_counts(results, key, which)
+        score.append(f"  {lab:10s}: library effects named right {c['named']}/{c['library']}, no-effect "
+                     f"right {c['no_effect_right']}/{c['no_effect']}, wrong names {c['wrong']}, clear "
+                     f"wrong {c['clear_wrong']}, values within x1.5 {c['within_1p5']}/{c['valued']}")
+    t_final = [r["diagnose_s"] for r in results]
+    t_first = [r["diagnose_s"] - ((r.get(key) or {}).get("time_s") or 0.0) for r in results]
+    times = [f"  time {lab}: mean {sum(t) / len(t):.1f} s, max {max(t):.1f} s, over 120 s: "
+             f"{sum(x > 120 for x in t)}" for lab, t in (("first pass", t_first), ("final", t_final))]
+    return score, times
+
+
 def judge(case: dict, verdict: str, confidence) -> dict:
     """``correct`` and ``confident_wrong`` of one verdict: right is the truth effect, or
     "none" / "unexplained" where the truth carries no library effect; a confident wrong

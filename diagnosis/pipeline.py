@@ -1951,6 +1951,18 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         }
         return meta
 
+    def pass_record(ps, refit_record):
+        """Verdict, confidence, reason and ranking of a pass not reported (kept in the meta)."""
+        s = build_summary(**_report_args(ps), meta=make_meta(model, ps, refit_record))
+        return {k: s.get(k) for k in ('verdict', 'verdict_confidence', 'verdict_reason', 'ranking')}
+
+    def road_on_band(nmax, high_band):
+        """The model's road on another band: nmax set, levels refitted, the nominal record run
+        again (lift-off times and noise floor with it); returns that record."""
+        model.nmax, model.high_band = nmax, high_band
+        model.gq = relevel_road(model, sig, cal_edges, model.gq, seed)
+        return nominal_record(model, sig, seed)
+
     try:
         ctx = prepare(sig, veh, seed=seed, n_windows=n_windows, road_fit=road_fit, workers=workers,
                       executor=ex)
@@ -1981,13 +1993,9 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                      'nmax_after': [float(x) for x in new], 'changed': changed,
                      'first_pass_s': round(first_pass_s, 2)}
             if changed:
-                first = build_summary(**_report_args(ps), meta=make_meta(model, ps, None))
-                refit['first_pass'] = {k: first.get(k) for k in ('verdict', 'verdict_confidence',
-                                                                  'verdict_reason', 'ranking')}
+                refit['first_pass'] = pass_record(ps, None)
                 refit['first_pass']['Gq_n0_m3'] = [float(g) for g in model.gq]
-                model.nmax, model.high_band = new, high_band
-                model.gq = relevel_road(model, sig, cal_edges, model.gq, seed)
-                simc = nominal_record(model, sig, seed)
+                simc = road_on_band(new, high_band)
                 progress(f"road band refitted with {top.effect} in the truck: nmax = "
                          + ', '.join(f'{x:g}' for x in new) + f" (was "
                          + ', '.join(f'{x:g}' for x in nmax_before) + '); the ranking again on it')
@@ -1995,7 +2003,6 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                 ps = one_pass(model, simc)
             refit['time_s'] = round(_time.perf_counter() - t, 2)
             timing['band_refit_s'] = refit['time_s']
-        joint = None
         if joint_band and ps['ranking'].gap_present:
             # the band chosen with the effect: a cut where the measured spectrum steps down in
             # spatial frequency (diagnosis.band_edge), the whole pass made on it, the pass whose
@@ -2008,15 +2015,12 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                      'nmax_before': [float(x) for x in before], 'margin': JOINT_BAND_MARGIN,
                      'first_pass_s': round(t - wall0, 2), 'chosen': 'fitted'}
             if tc['cut'] is not None and np.any(before > tc['cut']):
-                first = build_summary(**_report_args(ps), meta=make_meta(model, ps, refit))
+                first = pass_record(ps, refit)
                 kept = (model.nmax, model.high_band, model.gq, model.lift_times, model.noise, simc,
                         dict(timing))
                 new = np.minimum(before, tc['cut'])
-                model.nmax = new
-                model.high_band = {"cut": [int(k) for k in np.nonzero(new < ROAD_NMAX)[0]],
-                                   "rolloff": [], "vetoed": False}
-                model.gq = relevel_road(model, sig, cal_edges, model.gq, seed)
-                simc = nominal_record(model, sig, seed)
+                simc = road_on_band(new, {"cut": [int(k) for k in np.nonzero(new < ROAD_NMAX)[0]],
+                                          "rolloff": [], "vetoed": False})
                 progress(f"measured axle spectrum steps down at {tc['cut']:g} cycles/m: the pass "
                          f"again on a road cut there")
                 ps_cut = one_pass(model, simc)
@@ -2025,15 +2029,12 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                              gap_cut=round(g_cut, 4))
                 if g_cut < JOINT_BAND_MARGIN * g_fit:
                     joint['chosen'] = 'cut'
-                    joint['first_pass'] = {k: first.get(k) for k in ('verdict', 'verdict_confidence',
-                                                                      'verdict_reason', 'ranking')}
+                    joint['first_pass'] = first
                     joint['first_pass']['Gq_n0_m3'] = [float(g) for g in kept[2]]
                     joint['first_pass']['timing'] = {k: round(v, 2) for k, v in kept[6].items()}
                     ps = ps_cut
                 else:
-                    cut = build_summary(**_report_args(ps_cut), meta=make_meta(model, ps_cut, refit))
-                    joint['cut_pass'] = {k: cut.get(k) for k in ('verdict', 'verdict_confidence',
-                                                                  'verdict_reason', 'ranking')}
+                    joint['cut_pass'] = pass_record(ps_cut, refit)
                     model.nmax, model.high_band, model.gq, model.lift_times, model.noise, simc = kept[:6]
                     timing.clear()
                     timing.update(kept[6])

@@ -744,7 +744,7 @@ def _road_text(summary: Mapping) -> list:
         L.append(f"\nThe measured axle accelerations step down at {jb['trial_cut']:g} cycles/m in "
                  f"spatial frequency (step {jb['step'].get(format(jb['trial_cut'], 'g'))}, trigger "
                  f"{jb['threshold']:g}), as on a road that stops there (a replica of a profile "
-                 "sampled every 1 / (2 x that) m). The whole diagnosis was made on the fitted band "
+                 f"sampled every {0.5 / jb['trial_cut']:.3g} m). The whole diagnosis was made on the fitted band "
                  f"and on a road cut there: the best model's held-out gap {jb['gap_fitted']:.3g} "
                  f"against {jb['gap_cut']:.3g}; the cut band is taken only below "
                  f"{jb['margin']:g} x the fitted one's, so this report is the "

@@ -61,3 +61,31 @@ def test_out_of_library_drive_is_unexplained(tmp_path):
     blind = copy_without_truth(ds, tmp_path / "blind")
     s = diagnose(blind, tmp_path / "run", settings=dict(BLIND_SETTINGS), progress=lambda m: None)
     assert s["verdict"] in ("none", "unexplained"), s["verdict_reason"]
+
+
+def test_two_rules_are_scored_from_the_first_pass_kept_beside_the_final_verdict():
+    """A second-pass option (joint road band, band refit) keeps the first pass's verdict in the
+    case record; the counts of each rule come from it, and a case without it counts the same
+    for both (its first pass was final)."""
+    from diagnosis.blind import first_pass_result, two_rule_counts, two_rule_lines
+
+    case = dict(case=0, effect="leaf_friction", param="force", value=1000.0)
+    summ = {"verdict": "leaf_friction", "verdict_confidence": "clear",
+            "ranking": [{"effect": "leaf_friction", "parameters": {"leaf_friction": {"force": 1200.0}}}],
+            "meta": {"joint_band": {"trial_cut": 2.0, "chosen": "cut", "time_s": 70.0,
+                                    "first_pass": {"verdict": "unexplained", "verdict_confidence": "none",
+                                                   "ranking": []}}}}
+    fp = first_pass_result(case, summ, "joint_band")
+    assert fp["verdict"] == "unexplained" and not fp["correct"] and fp["param_ratio"] is None
+    assert first_pass_result(case, summ) is None            # no band refit in this summary
+    rs = [dict(case, verdict="leaf_friction", confidence="clear", correct=True, confident_wrong=False,
+               param_ratio=1.2, joint_band=fp, diagnose_s=150.0),
+          dict(case=1, effect="none", param=None, value=None, verdict="payload", confidence="ambiguous",
+               correct=False, confident_wrong=False, param_ratio=None, joint_band=None, diagnose_s=90.0)]
+    first, final = two_rule_counts(rs, "joint_band", "first"), two_rule_counts(rs, "joint_band")
+    assert (first["named"], first["valued"], first["wrong"]) == (0, 0, 1)
+    assert (final["named"], final["within_1p5"], final["wrong"]) == (1, 1, 1)
+    assert first["no_effect"] == final["no_effect"] == 1 and first["no_effect_right"] == 0
+    score, times = two_rule_lines(rs, "joint_band")
+    assert "named right 0/1" in score[0] and "named right 1/1" in score[1]
+    assert "max 90.0 s, over 120 s: 0" in times[0] and "max 150.0 s, over 120 s: 1" in times[1]
