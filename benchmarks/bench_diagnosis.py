@@ -81,8 +81,10 @@ def main(argv=None) -> int:
                          "verdict beside the final one")
     ap.add_argument("--joint-band", action="store_true",
                     help="choose the road band jointly with the effect (diagnosis.pipeline."
-                         "JOINT_BAND): a second pass on a road cut where the measured spectrum "
-                         "steps down; each case keeps the first pass's verdict beside the final one")
+                         "JOINT_BAND, the default since stop 57; the flag keeps the commands of "
+                         "results/diagnosis_blind/20261129-joint-band as they ran): a second pass on "
+                         "a road cut where the measured spectrum steps down; each case keeps the "
+                         "first pass's verdict beside the final one")
     ap.add_argument("--share-min", type=float, default=None)
     ap.add_argument("--signature-max", type=float, default=None)
     ap.add_argument("--signature-share", type=float, default=None)
