@@ -29,6 +29,13 @@ def _strip(summary):
     meta = dict(summary.get("meta", {}))
     for k in RUN_FIELDS:
         meta.pop(k, None)
+    for k in ("band_refit", "joint_band"):      # second passes record their own run times
+        if meta.get(k):
+            rec = {f: v for f, v in meta[k].items() if f not in ("time_s", "first_pass_s")}
+            for p in ("first_pass", "cut_pass"):
+                if rec.get(p):
+                    rec[p] = {f: v for f, v in rec[p].items() if f != "timing"}
+            meta[k] = rec
     return dict(summary, meta=meta)
 
 
