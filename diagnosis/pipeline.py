@@ -2020,8 +2020,10 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                      'first_pass_s': round(t - wall0, 2), 'chosen': 'fitted'}
             if tc['cut'] is not None and np.any(before > tc['cut']):
                 first = pass_record(ps, refit)
-                kept = (model.nmax, model.high_band, model.gq, model.lift_times, model.noise, simc,
-                        dict(timing))
+                # the fitted band's state, put back if its pass is the one reported
+                kept = dict(nmax=model.nmax, high_band=model.high_band, gq=model.gq,
+                            lift_times=model.lift_times, noise=model.noise)
+                kept_simc, kept_timing = simc, dict(timing)
                 new = np.minimum(before, tc['cut'])
                 simc = road_on_band(new, {"cut": [int(k) for k in np.nonzero(new < ROAD_NMAX)[0]],
                                           "rolloff": [], "vetoed": False})
@@ -2034,14 +2036,16 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                 if g_cut < JOINT_BAND_MARGIN * g_fit:
                     joint['chosen'] = 'cut'
                     joint['first_pass'] = first
-                    joint['first_pass']['Gq_n0_m3'] = [float(g) for g in kept[2]]
-                    joint['first_pass']['timing'] = {k: round(v, 2) for k, v in kept[6].items()}
+                    joint['first_pass']['Gq_n0_m3'] = [float(g) for g in kept['gq']]
+                    joint['first_pass']['timing'] = {k: round(v, 2) for k, v in kept_timing.items()}
                     ps = ps_cut
                 else:
                     joint['cut_pass'] = pass_record(ps_cut, refit)
-                    model.nmax, model.high_band, model.gq, model.lift_times, model.noise, simc = kept[:6]
+                    for name, value in kept.items():
+                        setattr(model, name, value)
+                    simc = kept_simc
                     timing.clear()
-                    timing.update(kept[6])
+                    timing.update(kept_timing)
                 progress(f"band: held-out gap {g_fit:.3g} on the fitted band, {g_cut:.3g} on the cut "
                          f"(margin {JOINT_BAND_MARGIN:g}): the {joint['chosen']} band's pass reported")
             joint['time_s'] = round(_time.perf_counter() - t, 2)
