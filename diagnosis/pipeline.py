@@ -378,6 +378,10 @@ class TruckModel:
     #: the inputs :func:`fit_road` gave :func:`fit_nmax` (``{"gq", "noise"}``), so that
     #: :func:`refit_band` repeats that fit with only the effects changed
     band_inputs: dict | None = None
+    #: integrator of the runs (``vehicles.simulate(solver=...)``): ``"linear"`` integrates
+    #: the runs whose model is linear on Exudyn's linearisation by the same scheme
+    #: (:mod:`vehicles.linear_sim`), ``"exudyn"`` every run in Exudyn
+    solver: str = "exudyn"
 
     def __getstate__(self):
         d = dict(self.__dict__)
@@ -478,7 +482,8 @@ class TruckModel:
         lt = self.lift_times
         expected = lt is not None and bool(np.any((lt >= t0 - LIFT_HINT_MARGIN_S) & (lt < t1)))
         res = simulate(self._vp(), road, prof, dur, effects=effects or None, x_start=x_start,
-                       fs_out=self.fs, seed=int(seed), lift_off_expected=expected)
+                       fs_out=self.fs, seed=int(seed), lift_off_expected=expected,
+                       solver=self.solver)
         out = {}
         for c in self.channels:
             x = np.asarray(res.channels[c], float)[n_run:n_run + n]
@@ -1345,7 +1350,7 @@ def inverse_road(sig: Signals, vehicle, workers: int = 2):
 
 
 def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fit: str = "levels",
-            workers: int = 2, executor=None) -> Context:
+            workers: int = 2, executor=None, solver: str | None = None) -> Context:
     """Segments, noise, calibration/held-out windows, nominal road, and the nominal
     simulation of the whole record (road-phase seed ``seed + 1``, noise-free).
 
@@ -1353,8 +1358,10 @@ def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fi
     ``"inverse"`` (:func:`inverse_road`, the full inverse fit of the whole record, used
     as it is; the held-out windows then take part in the road fit, which the per-window
     re-levelling of the ranking does anyway).  ``executor``: a process pool the road fit's
-    independent simulations are spread over (same results as without).
+    independent simulations are spread over (same results as without).  ``solver``: the
+    model's integrator (:attr:`TruckModel.solver`; default :data:`SIM_SOLVER`).
     """
+    solver = SIM_SOLVER if solver is None else solver
     t = _time.perf_counter()
     noise = noise_std(sig, list(sig.channels))
     calib, held, edges = windows(sig, n_windows)
@@ -1363,11 +1370,12 @@ def prepare(sig: Signals, vehicle, *, seed: int = 0, n_windows: int = 4, road_fi
         bounds, par = inverse_road(sig, vehicle, workers)
         model = TruckModel(vehicle, sig.time, sig.speed, bounds, par[:, 0].copy(), noise,
                            list(sig.channels), ref_axle=segment_axle(list(sig.channels)), w=par[:, 1].copy(),
-                           nmin=par[:, 2].copy(), nmax=par[:, 3].copy())
+                           nmin=par[:, 2].copy(), nmax=par[:, 3].copy(), solver=solver)
     elif road_fit == "levels":
         bounds = road_segments(sig)
         model = TruckModel(vehicle, sig.time, sig.speed, bounds, np.full(len(bounds) - 1, GQ_REF),
-                           noise, list(sig.channels), ref_axle=segment_axle(list(sig.channels)))
+                           noise, list(sig.channels), ref_axle=segment_axle(list(sig.channels)),
+                           solver=solver)
         model.gq, model.w = fit_road(model, sig, cal_edges, seed,
                                      mapper=executor.map if executor is not None else map)
     else:
@@ -1740,6 +1748,15 @@ BAND_REFIT = False
 #: 120 s against 2, max 207 s
 JOINT_BAND = True
 JOINT_BAND_MARGIN = 0.9
+#: the integrator of the diagnosis's runs (``diagnose(settings={"solver": ...})``,
+#: :attr:`TruckModel.solver`): ``"linear"`` integrates every run whose model is linear (the
+#: nominal truck, and candidates that change only the road, speed, sensors, masses or frame)
+#: on Exudyn's linearisation with Exudyn's own scheme (:mod:`vehicles.linear_sim`); nonlinear
+#: effects stay in Exudyn.  Adopted at stop 58: on 14 drives of stop 57's fresh set (both
+#: trucks, 10 effects and none, lift-off, the cut band) the same verdict and confidence on every
+#: drive, the first-ranked model's value within 0.01 %, time 0.7-1.6x
+#: (results/diagnosis_blind/20261129-linear-solver/)
+SIM_SOLVER = "linear"
 
 
 def best_heldout_gap(ranking) -> float:
@@ -1811,7 +1828,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     from diagnosis.compare import distribution_shape, transmissibility
     from diagnosis.report import build_summary, write_report
     from diagnosis.verdict import SIGNATURE_METHOD, own_statistic, search_ranges
-    from diagnosis.which import combine_folds, rank_effects
+    from diagnosis.which import combine_folds, rank_effects, rank_effects_folds
     from diagnosis.where import localize
     from eroad.threads import process_pool
     from vehicles.params import load_vehicle
@@ -1835,6 +1852,9 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     settings = dict(settings or {})
     band_refit = bool(settings.pop("band_refit", BAND_REFIT))
     joint_band = bool(settings.pop("joint_band", JOINT_BAND))
+    solver = str(settings.pop("solver", SIM_SOLVER))
+    if solver not in ("exudyn", "linear"):
+        raise EroadInputError(f"solver must be 'exudyn' or 'linear', got {solver!r}")
     T = sig.time.size / sig.fs      # record length [s]
 
     def one_pass(model, simc):
@@ -1879,13 +1899,20 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                  f"{len(held)} held-out windows ({workers} worker(s)"
                  + (", two folds: then the roles swapped)" if folds == 2 else ")"))
         splits = [(calib, held, seed)] + ([(held, calib, seed + 1)] if folds == 2 else [])
-        rankings = []
-        for c, h, sd in splits:
+
+        def terms():
             d_term, s_term, *extra = gap_terms(model, sig)
-            rankings.append(rank_effects(cands, fit, simulate, c, h, seed=sd, executor=ex,
-                                         progress=progress, delay=d_term, shape=s_term,
-                                         extra_terms=extra, task_order=TASK_ORDER, **kw))
-        ranking = rankings[0] if folds == 1 else combine_folds(rankings, candidates=cands)
+            return dict(delay=d_term, shape=s_term, extra_terms=extra)
+
+        if folds == 1:
+            ranking = rank_effects(cands, fit, simulate, calib, held, seed=seed, executor=ex,
+                                   progress=progress, task_order=TASK_ORDER, **terms(), **kw)
+        else:
+            # both folds' calibrations in one batch (no worker idle at the end of a fold)
+            ranking = combine_folds(rank_effects_folds(cands, fit, simulate, splits, executor=ex,
+                                                       terms=terms, progress=progress,
+                                                       task_order=TASK_ORDER, **kw),
+                                    candidates=cands)
         timing["ranking_s"] = _time.perf_counter() - t
         # the winner's signature: its axle-to-body transmissibility on the
         # nominal model's road and seed, against the measurement (diagnosis.verdict); both the
@@ -1944,7 +1971,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
             "heldout_windows_s": [[float(edges[i]), float(edges[i + 1])] for i in range(n_windows)
                                   if i % 2 == 1],
             "noise_std": model.noise, "wheelbase_m": wheelbase, "quick": bool(quick), "seed": int(seed),
-            "workers": int(workers), "candidates": [c.name for c in cands],
+            "workers": int(workers), "solver": model.solver, "candidates": [c.name for c in cands],
             "search_ranges": search_ranges(cands),
             "own_side": side_rec,
             "signature_method": SIGNATURE_METHOD,
@@ -1969,7 +1996,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
 
     try:
         ctx = prepare(sig, veh, seed=seed, n_windows=n_windows, road_fit=road_fit, workers=workers,
-                      executor=ex)
+                      executor=ex, solver=solver)
         model, calib, held, edges, bounds = ctx.model, ctx.calib, ctx.held, ctx.edges, ctx.bounds
         cal_edges, simc, segs = ctx.cal_edges, ctx.sim_nominal, ctx.segs
         timing["road_fit_s"] = ctx.road_fit_s

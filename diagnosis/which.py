@@ -1095,14 +1095,7 @@ def _paired_sd(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Callable,
-                 calib: Sequence, heldout: Sequence, *, seed: int = 0, n_seeds: int = 5,
-                 n_calib_seeds: int = 1, n_null: int | None = None, pairs: bool = True,
-                 n_pair_candidates: int = 3, channels: Sequence[str] | None = None,
-                 bands: np.ndarray | None = None, z: float = 2.0, grid: int = 5, refine: int = 8,
-                 executor=None, progress: Callable[[str], None] | None = None,
-                 delay: DelayTerm | None = None, shape: "ShapeTerm | None" = None,
-                 z_paired: float = 3.0, extra_terms: Sequence = (),
-                 task_order: Sequence[str] = ()) -> Ranking:
+                 calib: Sequence, heldout: Sequence, *, executor=None, **kw) -> Ranking:
     """Rank candidate effects by held-out gap, penalised for parameters; never force a verdict.
 
     Parameters
@@ -1115,6 +1108,76 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     calib, heldout : sequence of measured windows (Signals-like, or objects ``fit`` and
         ``simulate`` understand that ``as_signals`` can read)
         Disjoint in time (other segments or windows).
+    executor : concurrent.futures.Executor, optional
+        Candidates are calibrated in parallel with ``executor.map``.
+    **kw
+        The budget and terms of :func:`_ranking` (``seed``, ``n_seeds``, ``n_null``, ``pairs``,
+        ``grid``, ``refine``, ``delay``, ``shape``, ``extra_terms``, ``z``, ``z_paired``, ...).
+
+    Returns
+    -------
+    Ranking
+    """
+    mapper = executor.map if executor is not None else map
+    steps = _ranking(candidates, fit, simulate, calib, heldout, mapper=mapper, **kw)
+    tasks = next(steps)
+    try:
+        steps.send(list(mapper(_score_task, tasks)))
+    except StopIteration as done:
+        return done.value
+    raise RuntimeError("_ranking did not finish")   # pragma: no cover
+
+
+def rank_effects_folds(candidates: Sequence[Candidate], fit: Callable, simulate: Callable,
+                       splits: Sequence[tuple], *, executor=None, terms: Callable | None = None,
+                       **kw) -> list:
+    """:func:`rank_effects` for several folds at once: ``splits`` = [(calib, heldout, seed),
+    ...]; the candidate calibrations of every fold go to ``executor`` in one batch (longest
+    first across the folds), so that no worker waits for the end of a fold.  The same
+    rankings as one :func:`rank_effects` per fold (every task is computed from its own fold's
+    inputs and seeds alone; only the order of work changes).  ``terms``: called once per fold,
+    returns ``{"delay": ..., "shape": ..., "extra_terms": ...}`` (each fold its own term
+    objects, whose weights the fold sets).  Pairs are not tried (``pairs`` forced off)."""
+    mapper = executor.map if executor is not None else map
+    kw = dict(kw, pairs=False)
+    gens, batches = [], []
+    for c, h, sd in splits:
+        g = _ranking(candidates, fit, simulate, c, h, mapper=mapper, seed=sd,
+                     **dict(kw, **((terms or dict)())))
+        gens.append(g)
+        batches.append(next(g))
+    # interleave: each fold's tasks are already longest first
+    order = [(f, i) for i in range(max(len(b) for b in batches)) for f in range(len(batches))
+             if i < len(batches[f])]
+    results = list(mapper(_score_task, [batches[f][i] for f, i in order]))
+    per_fold = [[None] * len(b) for b in batches]
+    for (f, i), r in zip(order, results):
+        per_fold[f][i] = r
+    out = []
+    for g, res in zip(gens, per_fold):
+        try:
+            g.send(res)
+        except StopIteration as done:
+            out.append(done.value)
+    return out
+
+
+def _ranking(candidates: Sequence[Candidate], fit: Callable, simulate: Callable,
+             calib: Sequence, heldout: Sequence, *, seed: int = 0, n_seeds: int = 5,
+             n_calib_seeds: int = 1, n_null: int | None = None, pairs: bool = True,
+             n_pair_candidates: int = 3, channels: Sequence[str] | None = None,
+             bands: np.ndarray | None = None, z: float = 2.0, grid: int = 5, refine: int = 8,
+             mapper=map, progress: Callable[[str], None] | None = None,
+             delay: DelayTerm | None = None, shape: "ShapeTerm | None" = None,
+             z_paired: float = 3.0, extra_terms: Sequence = (),
+             task_order: Sequence[str] = ()):
+    """The ranking of :func:`rank_effects` as a generator: it yields the candidate
+    calibration tasks (:func:`_score_task` arguments, in submission order) and takes their
+    results back (``send``, same order); its return value is the Ranking.  The nominal
+    simulations and the pairs run with ``mapper``.
+
+    Parameters
+    ----------
     seed : int
         Root seed of all road-phase seeds.
     n_seeds : int
@@ -1135,8 +1198,8 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
         ``gap_present`` threshold in standard deviations of the nominal-vs-nominal gap.
     grid, refine : int
         Search budget (see :func:`calibrate`).
-    executor : concurrent.futures.Executor, optional
-        Candidates are calibrated in parallel with ``executor.map``.
+    mapper : callable
+        ``map`` or an executor's ``map``: the nominal simulations and the pairs.
     task_order : sequence of str
         Candidate names, longest calibration first: the order the calibrations are handed to
         ``executor`` (:func:`submission_order`); only the order of work changes.
@@ -1157,6 +1220,7 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     Returns
     -------
     Ranking
+        As the generator's return value (``StopIteration.value``).
     """
     say = progress or (lambda msg: None)
     if not candidates:
@@ -1167,7 +1231,6 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     sc = _Scorer(fit, simulate, calib, heldout, seed, n_calib_seeds, n_seeds, channels, bands)
 
     say("nominal model on held-out data")
-    mapper = executor.map if executor is not None else map
     n_nom = max(n_seeds, n_null)
     terms = [t for t in (delay, shape, *extra_terms) if t is not None]
     # the nominal simulations (held-out: stream 1, surrogates: stream 2; calibration windows
@@ -1231,8 +1294,8 @@ def rank_effects(candidates: Sequence[Candidate], fit: Callable, simulate: Calla
     say(f"calibrating {len(candidates)} candidates")
     # submitted longest first (task_order), results taken back in the candidates' order
     order = submission_order([c.name for c in candidates], task_order)
-    done = dict(zip(order, mapper(_score_task, [(sc, [candidates[i]], grid, refine, None)
-                                                for i in order])))
+    results = yield [(sc, [candidates[i]], grid, refine, None) for i in order]
+    done = dict(zip(order, results))
     singles = []
     for c, (cal, gaps, nm) in zip(candidates, (done[i] for i in range(len(candidates)))):
         singles.append(finish(_entry([c], cal, gaps, nm, before, c.k)))

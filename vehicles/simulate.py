@@ -46,6 +46,8 @@ from vehicles.tyre_contact import TYRE_CONTACTS, tyre_forces, unilateral_prestep
 #: Jacobian factorised once and one solve per step, joints ~1e4 times stiffer than
 #: nominal drift (measured: 1e3 fine, 1e4 diverges)
 STIFF_FRAME_NEWTON = 300.0
+#: integrators of :func:`simulate` (``solver``)
+SOLVERS = ("exudyn", "linear")
 #: channels larger than this [m] or [m/s^2] mean the solution diverged
 DIVERGENCE_LIMIT = {"susp_disp": 2.0, "axle_acc": 5e3, "body_acc": 5e3}
 #: how often a failed Newton run is repeated with the time step halved.  Stiff
@@ -303,7 +305,7 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
              dt: float | None = None, fs_out: float = 200.0, x_start: float | None = None,
              y_offset: float = 0.0, seed: int | None = None, frame_segments: int | None = None,
              newton: bool | None = None, tyres: str = "unilateral",
-             lift_off_expected: bool = False) -> SimResult:
+             lift_off_expected: bool = False, solver: str = "exudyn") -> SimResult:
     """Simulate a vehicle driving over a road.
 
     The linear model (no nonlinear effect) is integrated with one linear solve per
@@ -361,6 +363,12 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     lift_off_expected : bool
         With unilateral tyres: run with the one-sided correction at once (no linear run
         first).  Same result; faster when a tyre does lift off, slower when none does.
+    solver : {"exudyn", "linear"}
+        ``"linear"``: where the drive's model is linear (no nonlinear effect, no forced
+        Newton iterations, no DCDC body) it is integrated on Exudyn's linearisation with the
+        same generalized-alpha scheme and step, tyre lift-off corrected as Exudyn's unilateral
+        run corrects it (:mod:`vehicles.linear_sim`; ``meta["solver"]`` says which ran).
+        Default: Exudyn always.
 
     Returns
     -------
@@ -377,8 +385,10 @@ def simulate(vehicle, road, speed, duration: float, chassis: str = "rigid", effe
     """
     if tyres not in TYRE_CONTACTS:
         raise EroadInputError(f"tyres must be one of {', '.join(TYRE_CONTACTS)}, got {tyres!r}")
+    if solver not in SOLVERS:
+        raise EroadInputError(f"solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
     kw = dict(chassis=chassis, effects=effects, fs_out=fs_out, x_start=x_start,
-              y_offset=y_offset, seed=seed, frame_segments=frame_segments)
+              y_offset=y_offset, seed=seed, frame_segments=frame_segments, solver=solver)
     wall0, cpu0 = _time.perf_counter(), _time.process_time()
     direct = tyres == "unilateral" and bool(lift_off_expected)
     res = _simulate_retrying(vehicle, road, speed, duration, dt, newton, direct, kw)
@@ -427,22 +437,55 @@ def _stamp_times(res: SimResult, wall0: float, cpu0: float) -> None:
     res.meta["cpu_realtime_factor"] = res.meta["duration"] / res.meta["cpu_s"]
 
 
-def _simulate(*args, **kw) -> SimResult:
+def _simulate(vehicle, road, speed, duration, *, solver: str = "exudyn", **kw) -> SimResult:
     """One attempt of :func:`simulate` (``newton`` None: only for nonlinear effects); the
-    Exudyn systems it builds are released afterwards, whatever happens."""
+    Exudyn systems it builds are released afterwards, whatever happens.  ``solver="linear"``:
+    a linear drive (:func:`vehicles.linear_sim.applies`) is integrated on the linearised model
+    by the same scheme instead."""
+    if solver == "linear":
+        from vehicles import linear_sim
+
+        wall0, cpu0 = _time.perf_counter(), _time.process_time()
+        pl = _plan_drive(vehicle, road, speed, duration, kw["chassis"], kw["effects"], kw["dt"],
+                         kw["fs_out"], kw["x_start"], kw["seed"], kw["frame_segments"])
+        if linear_sim.applies(pl.eff, pl.vp, pl.ctx.chassis, pl.ctx.stiffness_factor, kw["newton"]):
+            return linear_sim.run(pl, road, kw["y_offset"], wall0, cpu0, unilateral=kw["unilateral"])
     built: list = []
     try:
-        return _simulate_once(*args, built=built, **kw)
+        return _simulate_once(vehicle, road, speed, duration, built=built, **kw)
     finally:
         for m in built:
             m.release()
 
 
-def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_start,
-                   y_offset, seed, frame_segments, newton, unilateral, built) -> SimResult:
-    wall0 = _time.perf_counter()
-    cpu0 = _time.process_time()
-    import exudyn as exu
+@dataclass
+class _DrivePlan:
+    """What both integrators of a drive share: the effects configured, the road as the
+    tyres meet it, the time grid and the distance travelled on it."""
+
+    vp0: VehicleParams
+    vp: VehicleParams
+    ctx: EffectContext
+    eff: dict
+    profile: SpeedProfile
+    road_used: object
+    dt: float
+    t_out: float
+    n_sub: int
+    n_steps: int
+    n_out: int
+    t_steps: np.ndarray
+    s_steps: np.ndarray
+    x_start: float
+    seed: int
+    duration: float
+    fs_out: float
+
+
+def _plan_drive(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_start, seed,
+                frame_segments) -> _DrivePlan:
+    """Validate the drive, configure the effects, put the road under the tyres' time grid
+    and check that the road covers the drive (refused before anything is simulated)."""
     vp0: VehicleParams = load_vehicle(vehicle)
     try:
         duration = float(duration)
@@ -477,13 +520,12 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
                         fs_out=fs_out, dt=dt, seed=seed)
     for name, p in eff.items():
         EFFECTS[name].configure(ctx, p)
-    vp = ctx.vp
     road_used = road
     for name, p in eff.items():
         road_used = EFFECTS[name].road(road_used, p, ctx)
 
     # ---- road coverage (refuse before simulating)
-    xs_axle = np.array([a.x for a in vp.axles])
+    xs_axle = np.array([a.x for a in ctx.vp.axles])
     margin = 0.5 * ctx.notes.get("tyre_enveloping_length_m", 0.0)
     if x_start is None:
         x_start = road.x_min - xs_axle.min() + margin + 1e-9
@@ -496,6 +538,23 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
             f"road too short: the drive needs x from {need_lo:.2f} to {need_hi:.2f} m, the road "
             f"covers {road.x_min:.2f} to {road.x_max:.2f} m (duration {duration:g} s, distance "
             f"{s_steps[-1]:.1f} m)")
+    return _DrivePlan(vp0=vp0, vp=ctx.vp, ctx=ctx, eff=eff, profile=profile, road_used=road_used,
+                      dt=dt, t_out=t_out, n_sub=n_sub, n_steps=n_steps, n_out=n_out,
+                      t_steps=t_steps, s_steps=s_steps, x_start=x_start, seed=seed,
+                      duration=duration, fs_out=fs_out)
+
+
+def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_start,
+                   y_offset, seed, frame_segments, newton, unilateral, built) -> SimResult:
+    wall0 = _time.perf_counter()
+    cpu0 = _time.process_time()
+    import exudyn as exu
+    pl = _plan_drive(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_start, seed,
+                     frame_segments)
+    vp0, vp, ctx, eff, profile, road_used = pl.vp0, pl.vp, pl.ctx, pl.eff, pl.profile, pl.road_used
+    dt, t_out, n_sub, n_steps, n_out = pl.dt, pl.t_out, pl.n_sub, pl.n_steps, pl.n_out
+    t_steps, s_steps, x_start, seed = pl.t_steps, pl.s_steps, pl.x_start, pl.seed
+    duration, fs_out = pl.duration, pl.fs_out
 
     # ---- model
     terms_of = None
@@ -667,19 +726,35 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
             ordered[f"dcdc_z_P{k}"] = pos[f"P{k}"][:, 2]
         extra.update(_dcdc_reference(model, ref_model, data["dcdc"]))
     ordered["speed"] = profile.speed(time)
-    channels = ordered
+    run = {"chassis": model.chassis,
+           "frame_segments": len(model.segments) if model.chassis == "flexible" else 1,
+           "frame_stiffness_factor": model.stiffness_factor, "steps": steps, "solve_s": solve_s,
+           "solve_cpu_s": solve_cpu, "n_dof": model.n_dof, "n_bodies": len(model.bodies),
+           "newton": nonlinear, "tyre_off_steps": int(off["steps_off"]) if off is not None else 0,
+           "tyre_contact_run": "unilateral" if unilateral else "linear",
+           "exudyn_version": exu.__version__, "solver": "exudyn"}
+    return _finish_result(pl, ordered, extra, zc, zr, zr_t, kc, cc, model.static_tyre_loads(),
+                          unilateral, run, road, y_offset, wall0, cpu0, out_cpu0)
+
+
+def _finish_result(pl: _DrivePlan, channels: dict, extra: dict, zc, zr, zr_t, kc, cc, f_static,
+                   unilateral: bool, run: dict, road, y_offset: float, wall0: float, cpu0: float,
+                   out_cpu0: float) -> SimResult:
+    """The part of a drive's result both integrators make alike: the divergence check, the
+    tyre forces and lift-off on the output grid, the effects' output hooks and the meta."""
+    time = np.arange(pl.n_out) * pl.t_out
+    duration = pl.duration
     try:
-        _check_divergence(channels, time, eff, dt, duration)
+        _check_divergence(channels, time, pl.eff, pl.dt, duration)
     except SimulationError as exc:
-        exc.newton, exc.dt = nonlinear, dt
+        exc.newton, exc.dt = run["newton"], pl.dt
         raise
 
     # tyre forces (dynamic part) and lift-off: a linear tyre "pulls" where it would carry
     # tension or press while off the road (what the unilateral correction changes)
-    k_out = np.arange(n_out) * n_sub
+    k_out = np.arange(pl.n_out) * pl.n_sub
     zr_o, zr_t_o = zr[k_out], zr_t[k_out]
-    zc_t = np.gradient(zc, t_out, axis=0)
-    f_static = model.static_tyre_loads()
+    zc_t = np.gradient(zc, pl.t_out, axis=0)
     defl = f_static / kc + zr_o - zc
     rate = zr_t_o - zc_t
     f_lin = kc * defl + cc * rate
@@ -690,36 +765,37 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
     extra["tyre_force"] = (f_uni if unilateral else f_lin) - f_static
     extra["tyre_off"] = lift
 
-    meta_eff = {n: dict(p) for n, p in eff.items()}
-    for name, p in eff.items():
-        EFFECTS[name].outputs(time, channels, p, ctx)
+    meta_eff = {n: dict(p) for n, p in pl.eff.items()}
+    for name, p in pl.eff.items():
+        EFFECTS[name].outputs(time, channels, p, pl.ctx)
     units = {n: unit_of(n) for n in channels}
     wall = _time.perf_counter() - wall0
     cpu = _time.process_time() - cpu0
     out_cpu = _time.process_time() - out_cpu0
     meta = {
-        "vehicle": vp0.id, "vehicle_name": vp0.name, "chassis": model.chassis,
-        "frame_segments": len(model.segments) if model.chassis == "flexible" else 1,
-        "frame_stiffness_factor": model.stiffness_factor,
-        "effects": meta_eff, "effect_notes": dict(ctx.notes),
-        "dt": dt, "fs_out": fs_out, "duration": duration, "steps": steps,
-        "wall_s": wall, "solve_s": solve_s, "realtime_factor": duration / wall,
-        "cpu_s": cpu, "solve_cpu_s": solve_cpu, "cpu_realtime_factor": duration / cpu,
-        "outputs_cpu_s": out_cpu, "prepare_cpu_s": cpu - solve_cpu - out_cpu,
-        "n_dof": model.n_dof, "n_bodies": len(model.bodies), "newton": nonlinear,
+        "vehicle": pl.vp0.id, "vehicle_name": pl.vp0.name, "chassis": run["chassis"],
+        "frame_segments": run["frame_segments"],
+        "frame_stiffness_factor": run["frame_stiffness_factor"],
+        "effects": meta_eff, "effect_notes": dict(pl.ctx.notes),
+        "dt": pl.dt, "fs_out": pl.fs_out, "duration": duration, "steps": run["steps"],
+        "wall_s": wall, "solve_s": run["solve_s"], "realtime_factor": duration / wall,
+        "cpu_s": cpu, "solve_cpu_s": run["solve_cpu_s"], "cpu_realtime_factor": duration / cpu,
+        "outputs_cpu_s": out_cpu, "prepare_cpu_s": cpu - run["solve_cpu_s"] - out_cpu,
+        "n_dof": run["n_dof"], "n_bodies": run["n_bodies"], "newton": run["newton"],
         "newton_fallback": False, "dt_halvings": 0,
-        "speed_mean": float(np.mean(profile.speed(time))), "distance_m": float(s_steps[-1]),
-        "x_start": x_start, "y_offset": float(y_offset), "seed": seed,
+        "speed_mean": float(np.mean(pl.profile.speed(time))), "distance_m": float(pl.s_steps[-1]),
+        "x_start": pl.x_start, "y_offset": float(y_offset), "seed": pl.seed,
         "tyre_lift_off_fraction": float(lift.mean()),
         "tyre_pull_fraction": float(pull.mean()),
-        "tyre_contact_run": "unilateral" if unilateral else "linear",
-        "tyre_off_steps": int(off["steps_off"]) if off is not None else 0,
+        "tyre_contact_run": run["tyre_contact_run"],
+        "tyre_off_steps": run["tyre_off_steps"],
         "road": {k: v for k, v in (getattr(road, "meta", {}) or {}).items()
                  if isinstance(v, (int, float, str, bool))},
-        "exudyn_version": exu.__version__,
+        "exudyn_version": run["exudyn_version"],
+        "solver": run["solver"],
     }
-    return SimResult(time=time, channels=channels, units=units, meta=meta, extra=extra, vehicle=vp,
-                     nominal_vehicle=vp0)
+    return SimResult(time=time, channels=channels, units=units, meta=meta, extra=extra, vehicle=pl.vp,
+                     nominal_vehicle=pl.vp0)
 
 
 def _dcdc_reference(model, ref_model, data) -> dict:
