@@ -205,8 +205,7 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
     the result as :func:`vehicles.simulate.simulate` makes it (``meta["solver"]`` "linear").
     ``unilateral``: tyres that lift off carry no force (:func:`integrate_unilateral`)."""
     import exudyn as exu
-    from eroad.errors import EroadInputError
-    from vehicles.simulate import _finish_result, road_under_tyres
+    from vehicles.simulate import _finish_result, check_road_width, road_under_tyres
 
     ctx = pl.ctx
     own = model_for(ctx.vp, ctx.chassis, ctx.frame_segments, ctx.stiffness_factor)
@@ -214,12 +213,7 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
                                                            ctx.frame_segments, ctx.stiffness_factor)
     lm = own["lm"]
     model = lm.model
-    if road.y.size > 1:
-        ys = y_offset + np.array([c.y for c in model.contacts])
-        if ys.min() < road.y[0] - 1e-9 or ys.max() > road.y[-1] + 1e-9:
-            raise EroadInputError(
-                f"road too narrow: tyres run at y from {ys.min():.2f} to {ys.max():.2f} m, the road "
-                f"covers {road.y[0]:.2f} to {road.y[-1]:.2f} m")
+    check_road_width(road, model, y_offset)
     zr, zr_t = road_under_tyres(pl.road_used, model, pl.x_start, y_offset, pl.s_steps,
                                 pl.profile.speed(pl.t_steps))
     rho = pl.vp.solver.spectral_radius

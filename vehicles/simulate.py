@@ -458,6 +458,16 @@ def _simulate(vehicle, road, speed, duration, *, solver: str = "exudyn", **kw) -
             m.release()
 
 
+def check_road_width(road, model, y_offset: float) -> None:
+    """Refuse a 3D road narrower than the vehicle's tyre tracks (one clear line)."""
+    if road.y.size > 1:
+        ys = y_offset + np.array([c.y for c in model.contacts])
+        if ys.min() < road.y[0] - 1e-9 or ys.max() > road.y[-1] + 1e-9:
+            raise EroadInputError(
+                f"road too narrow: tyres run at y from {ys.min():.2f} to {ys.max():.2f} m, the road "
+                f"covers {road.y[0]:.2f} to {road.y[-1]:.2f} m")
+
+
 @dataclass
 class _DrivePlan:
     """What both integrators of a drive share: the effects configured, the road as the
@@ -567,12 +577,7 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
     model = build_model(vp, chassis=ctx.chassis, frame_segments=ctx.frame_segments,
                         stiffness_factor=ctx.stiffness_factor, suspension_terms=terms_of)
     built.append(model)
-    if road.y.size > 1:
-        ys = y_offset + np.array([c.y for c in model.contacts])
-        if ys.min() < road.y[0] - 1e-9 or ys.max() > road.y[-1] + 1e-9:
-            raise EroadInputError(
-                f"road too narrow: tyres run at y from {ys.min():.2f} to {ys.max():.2f} m, the road "
-                f"covers {road.y[0]:.2f} to {road.y[-1]:.2f} m")
+    check_road_width(road, model, y_offset)
     ref_model = model
     if ctx.reference_vp is not vp:
         ref_model = build_model(ctx.reference_vp, chassis=ctx.chassis,
