@@ -1755,7 +1755,9 @@ JOINT_BAND_MARGIN = 0.9
 #: effects stay in Exudyn.  Adopted at stop 58: on 14 drives of stop 57's fresh set (both
 #: trucks, 10 effects and none, lift-off, the cut band) the same verdict and confidence on every
 #: drive, the first-ranked model's value within 0.01 %, time 0.7-1.6x
-#: (results/diagnosis_blind/20261129-linear-solver/)
+#: (results/diagnosis_blind/20261129-linear-solver/); on the next fresh set the six drives with
+#: a wrong or missing verdict gave the same verdicts with Exudyn (a test stated before those
+#: runs, results/diagnosis_blind/20261129-linear-fresh-40/ab_exudyn.txt)
 SIM_SOLVER = "linear"
 
 
@@ -1847,14 +1849,14 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     progress(f"dataset {drive.name}: {sig.duration:.1f} s, {len(sig.channels)} channels, "
              f"vehicle {vp.id}" + (f"; resampled from {sig.meta['resampled_from_hz']:g} to {sig.fs:g} Hz"
                                    if "resampled_from_hz" in sig.meta else ""))
-    # one pool for the road fit, the ranking and the signatures; shut down however it ends
-    ex = process_pool(workers) if workers and workers > 1 else None
     settings = dict(settings or {})
     band_refit = bool(settings.pop("band_refit", BAND_REFIT))
     joint_band = bool(settings.pop("joint_band", JOINT_BAND))
     solver = str(settings.pop("solver", SIM_SOLVER))
     if solver not in ("exudyn", "linear"):
         raise EroadInputError(f"solver must be 'exudyn' or 'linear', got {solver!r}")
+    # one pool for the road fit, the ranking and the signatures; shut down however it ends
+    ex = process_pool(workers) if workers and workers > 1 else None
     T = sig.time.size / sig.fs      # record length [s]
 
     def one_pass(model, simc):

@@ -298,3 +298,14 @@ def test_window_road_has_no_segment_the_truck_does_not_reach(short_drive):
     assert np.std(r.z) < 3.0 * np.std(r0.z)
     m2 = dataclasses.replace(m, bounds=np.array([0.0, 6.3, sig.duration]), _roads={})
     assert np.std(m2._road(0.0, 6.0, 3, m2.gq).z) > 10.0 * np.std(r0.z)
+
+
+def test_unknown_integrator_setting_refused_before_any_work(short_drive, tmp_path):
+    """``settings={"solver": ...}`` takes "linear" or "exudyn"; anything else is one clear line
+    (EroadInputError), raised before a worker pool is started or a run folder written."""
+    from diagnosis.pipeline import diagnose
+    from eroad.errors import EroadInputError
+
+    with pytest.raises(EroadInputError, match="solver must be 'exudyn' or 'linear'"):
+        diagnose(short_drive, tmp_path / "out", settings={"solver": "fast"}, workers=2)
+    assert not (tmp_path / "out").exists()

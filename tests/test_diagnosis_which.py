@@ -568,3 +568,33 @@ def test_term_weight_is_half_the_band_gaps_null_sd_over_root_two():
     assert term_weight([4.0, 4.0]) == 0.0
     assert term_weight([1.0]) == 0.0
     assert term_weight([1.0, float("nan"), 2.0]) == 0.0
+
+
+def test_folds_in_one_batch_are_the_folds_one_after_the_other():
+    """``rank_effects_folds`` hands both folds' calibrations to the executor in one batch and
+    routes the results back: each fold's ranking must be the one ``rank_effects`` makes for that
+    fold alone (same entries, gaps, calibrations, verdict).  On the toy model, two folds with the
+    windows' roles swapped, a thread pool so that the batch is really interleaved."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from diagnosis import toy
+    from diagnosis.which import rank_effects, rank_effects_folds
+
+    truth = toy.make_state({"sensor": {"cutoff_hz": 15.0}})
+    meas = toy.simulate_drive(truth, 60.0, 10.0, 3)
+    w = [meas.window(i * 15.0, (i + 1) * 15.0) for i in range(4)]
+    calib, held = [w[0], w[2]], [w[1], w[3]]
+    kw = dict(n_seeds=3, n_null=3, grid=3, refine=3, pairs=False)
+    one = [rank_effects(toy.TOY_CANDIDATES, toy.fit, toy.simulate, c, h, seed=sd, **kw)
+           for c, h, sd in ((calib, held, 1), (held, calib, 2))]
+    with ThreadPoolExecutor(2) as ex:
+        both = rank_effects_folds(toy.TOY_CANDIDATES, toy.fit, toy.simulate,
+                                  [(calib, held, 1), (held, calib, 2)], executor=ex, **kw)
+    assert len(both) == 2
+    for a, b in zip(one, both):
+        assert (a.verdict, a.confidence) == (b.verdict, b.confidence)
+        assert [e.effect for e in a.entries] == [e.effect for e in b.entries]
+        for ea, eb in zip(a.entries, b.entries):
+            assert ea.effects == eb.effects
+            np.testing.assert_array_equal(ea.after, eb.after)
+        np.testing.assert_array_equal(a.before, b.before)
