@@ -1834,6 +1834,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     from diagnosis.where import localize
     from eroad.threads import process_pool
     from vehicles.params import load_vehicle
+    from vehicles.simulate import SOLVERS
 
     wall0 = _time.perf_counter()
     record = run_info("diagnose", seed=seed, extra={"quick": bool(quick), "workers": int(workers)})
@@ -1853,8 +1854,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     band_refit = bool(settings.pop("band_refit", BAND_REFIT))
     joint_band = bool(settings.pop("joint_band", JOINT_BAND))
     solver = str(settings.pop("solver", SIM_SOLVER))
-    if solver not in ("exudyn", "linear"):
-        raise EroadInputError(f"solver must be 'exudyn' or 'linear', got {solver!r}")
+    if solver not in SOLVERS:       # the integrators vehicles.simulate offers
+        raise EroadInputError(f"solver must be {' or '.join(map(repr, SOLVERS))}, got {solver!r}")
     # one pool for the road fit, the ranking and the signatures; shut down however it ends
     ex = process_pool(workers) if workers and workers > 1 else None
     T = sig.time.size / sig.fs      # record length [s]
