@@ -3,7 +3,8 @@
 The drives are the shape the gap diagnosis simulates by the hundred: the dump truck over
 ``--duration`` s (default 9.5: a 7.5 s window and its 2 s run-in) at 8 -> 12 m/s on a class C
 road, ``--n`` road seeds.  Printed per variant (nominal truck; a payload, whose model is
-linearised anew for each value as a calibration does; a flexible frame): the wall time per
+linearised anew for each value as a calibration does; a flexible frame; the nonlinear effects,
+whose suspension forces the linear integrator solves step by step): the wall time per
 drive of each integrator, their ratio measured in this run, and the agreement, as in
 ``bench_vehicles.py``: ``rms_err`` = max over channels of |RMS(linear) / RMS(exudyn) - 1|
 (the level the diagnosis compares) and ``wave_err`` = max over channels of
@@ -42,7 +43,14 @@ def main(argv=None) -> int:
     length = 12.0 * d + 20.0
     variants = [("nominal", lambda i: None),
                 ("payload (new value each drive)", lambda i: {"payload": {"mass": 1000.0 + 500.0 * i}}),
-                ("frame_flex", lambda i: {"frame_flex": {}})]
+                ("frame_flex", lambda i: {"frame_flex": {}}),
+                # the nonlinear effects: local suspension forces solved per step
+                # (vehicles/suspension_forces.py) against Exudyn's Newton run
+                ("leaf_friction 2 kN", lambda i: {"leaf_friction": {"force": 2000.0}}),
+                ("leaf_friction 12 kN, v0 5 mm/s", lambda i: {"leaf_friction": {"force": 12000.0,
+                                                                                 "velocity": 0.005}}),
+                ("damper_asymmetry 4", lambda i: {"damper_asymmetry": {"ratio": 4.0}}),
+                ("bump_stop 10 mm", lambda i: {"bump_stop": {"gap": 0.01}})]
     print(f"dump truck, {d:g} s at 8 -> 12 m/s, class C, {args.n} road seeds per variant")
     print(f"{'variant':32s} {'exudyn s':>9s} {'linear s':>9s} {'ratio':>7s} {'rms_err':>9s} {'wave_err':>9s}")
     for name, eff in variants:

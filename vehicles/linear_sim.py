@@ -12,9 +12,13 @@ model, so a drive costs a matrix product per step instead of an Exudyn solve.
 
 What it is not: an approximation in frequency (no FFT, no periodic wrap, the run-in and the
 speed profile are those of the time simulation) nor a replacement where the model is not
-linear: nonlinear effects, forced Newton iterations and vehicles with a DCDC body go to Exudyn
-(:func:`applies`).  Tyre lift-off is not a reason: the unilateral run corrects the tyre forces
-step by step exactly as Exudyn's does (:func:`integrate_unilateral`).
+linear beyond local suspension forces: forced Newton iterations, effects whose forces have no
+element kind and vehicles with a DCDC body go to Exudyn (:func:`applies`).  Tyre lift-off is
+not a reason: the unilateral run corrects the tyre forces step by step exactly as Exudyn's
+does (:func:`integrate_unilateral`).  Nor are the library's nonlinear effects (leaf friction,
+asymmetric dampers, bump stops): each is a force on one axle side that depends on that side's
+compression and rate only, solved implicitly at every step's end
+(:mod:`vehicles.suspension_forces`, :func:`suspension_elements`).
 
 Agreement with Exudyn (``tests/test_linear_sim.py``): the difference is the geometric
 nonlinearity Exudyn keeps (rotations of a few milliradians) and the two rotation
@@ -142,19 +146,48 @@ def integrate_unilateral(Phi, Gam, x0, F, Bu, rows, base, kc, cc, zr, zr_t, dt: 
 
 
 def applies(eff: dict, vp, chassis: str, stiffness_factor: float, newton) -> bool:
-    """Whether a drive's model is linear (tyre lift-off aside, which :func:`run` corrects as
-    Exudyn's run does), so that :func:`run` gives what Exudyn gives."""
+    """Whether :func:`run` gives what Exudyn gives for this drive: a linear model, with tyre
+    lift-off (corrected as Exudyn's run does) and local nonlinear suspension forces (effects
+    with :meth:`~vehicles.effects.base.Effect.suspension_elements`, solved per step) allowed."""
     from vehicles.simulate import STIFF_FRAME_NEWTON
 
     if newton or vp.dcdc is not None:
         return False
     if chassis == "flexible" and stiffness_factor > STIFF_FRAME_NEWTON:
         return False
+    local = False
     for name in eff:
         e = EFFECTS[name]
-        if e.nonlinear or type(e).suspension_terms is not Effect.suspension_terms:
+        elements = type(e).suspension_elements is not Effect.suspension_elements
+        if (e.nonlinear or type(e).suspension_terms is not Effect.suspension_terms) and not elements:
+            return False
+        local = local or elements
+    if local:
+        # the local nonlinear forces are stepped by a compiled loop; without numba they run
+        # in Exudyn (the same forces, its own Newton iterations)
+        try:
+            import numba  # noqa: F401
+        except ImportError:  # pragma: no cover - numba is a dependency
             return False
     return True
+
+
+def suspension_elements(entry, eff: dict, ctx) -> tuple:
+    """The local nonlinear suspension forces of the effects in ``eff`` on the model of
+    ``entry`` (:func:`model_for`): ``(elements, Cq)``, the element list of
+    :mod:`vehicles.suspension_forces` and each element's compression row (m, n)."""
+    model = entry["lm"].model
+    elements, rows = [], []
+    for k, su in enumerate(model.suspensions):
+        for name, p in eff.items():
+            e = EFFECTS[name]
+            if type(e).suspension_elements is Effect.suspension_elements:
+                continue
+            for el in e.suspension_elements(su, p, ctx) or []:
+                elements.append(el)
+                rows.append(entry["susp_rows"][k])
+    n = entry["lm"].n_dof
+    return elements, (np.array(rows) if rows else np.zeros((0, n)))
 
 
 def model_for(vp, chassis: str, frame_segments, stiffness_factor: float):
@@ -172,8 +205,12 @@ def model_for(vp, chassis: str, frame_segments, stiffness_factor: float):
     m = lm.model
     # tyre contact points (vertical), for the deflection and lift-off check
     rows = np.array([kin.point(m.axles[ct.axle].name, ct.local)[2] for ct in m.contacts])
-    entry = {"key": key, "lm": lm, "contact_rows": rows, "f_static": m.static_tyre_loads(),
-             "recurrence": {}, "offsets": {}}
+    # each axle side's compression u = z(axle seat) - z(frame seat) (vehicles.builder.Suspension)
+    susp = np.array([kin.point(m.axles[su.axle].name, su.local_axle)[2]
+                     - kin.point(m.segments[su.segment].name, su.local_frame)[2]
+                     for su in m.suspensions]) if m.suspensions else np.zeros((0, lm.n_dof))
+    entry = {"key": key, "lm": lm, "contact_rows": rows, "susp_rows": susp,
+             "f_static": m.static_tyre_loads(), "recurrence": {}, "offsets": {}}
     _models[key] = entry
     while len(_models) > CACHE_SIZE:
         _models.popitem(last=False)
@@ -205,6 +242,7 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
     the result as :func:`vehicles.simulate.simulate` makes it (``meta["solver"]`` "linear").
     ``unilateral``: tyres that lift off carry no force (:func:`integrate_unilateral`)."""
     import exudyn as exu
+    from eroad.errors import SimulationError
     from vehicles.simulate import _finish_result, check_road_width, road_under_tyres
 
     ctx = pl.ctx
@@ -235,7 +273,28 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
     kc = np.array([c.stiffness for c in model.contacts])
     cc = np.array([c.damping for c in model.contacts])
     off = 0
-    if unilateral:
+    elements, Cq = suspension_elements(own, pl.eff, ctx)
+    newton_iter = 0
+    if elements:
+        from vehicles import suspension_forces as sf
+        from vehicles.simulate import _failure_message
+
+        kinds, prm = sf.element_arrays(elements)
+        uni = None
+        if unilateral:
+            Bu = lm.Bk / kc[None, :]
+            uni = (Bu, np.ascontiguousarray(Bu.T), own["f_static"] / kc, kc, cc, zr, zr_t, pl.dt)
+        X, off, newton_iter, failed = sf.integrate(Phi, Gam, x0, F, pl.n_sub, pl.n_out, Cq,
+                                                   kinds, prm, unilateral=uni)
+        if failed >= 0 or X.shape[0] < pl.n_out:
+            t_fail = (failed if failed >= 0 else X.shape[0] * pl.n_sub) * pl.dt
+            exc = SimulationError(_failure_message(
+                t_fail, pl.duration, pl.eff, pl.dt,
+                f"the local Newton iterations of the suspension forces did not converge "
+                f"within {sf.MAX_ITER}"))
+            exc.newton, exc.dt, exc.smaller_dt_may_help = True, pl.dt, True
+            raise exc
+    elif unilateral:
         Bu = lm.Bk / kc[None, :]
         # the contact heights as Exudyn's correction reads them: the transpose of the road
         # input map (tyre_contact.unilateral_prestep)
@@ -262,7 +321,9 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
     run_info = {"chassis": lm.chassis, "frame_segments": lm.meta["frame_segments"],
                 "frame_stiffness_factor": lm.meta["stiffness_factor"], "steps": pl.n_steps,
                 "solve_s": solve_s, "solve_cpu_s": solve_cpu, "n_dof": n,
-                "n_bodies": len(model.bodies), "newton": False, "tyre_off_steps": off,
+                "n_bodies": len(model.bodies), "newton": bool(elements),
+                "newton_iterations": int(newton_iter), "suspension_elements": len(elements),
+                "tyre_off_steps": off,
                 "tyre_contact_run": "unilateral" if unilateral else "linear",
                 "exudyn_version": exu.__version__,
                 "solver": "linear"}

@@ -236,5 +236,12 @@ class Effect:
         """
         return []
 
+    def suspension_elements(self, susp, p: dict, ctx: EffectContext) -> list | None:
+        """The same forces as :meth:`suspension_terms`, as element kinds of
+        :mod:`vehicles.suspension_forces` (``[(kind, params), ...]``), so that the linear
+        integrator can step them (``simulate(solver="linear")``); None (the default): not
+        expressible there, the drive runs in Exudyn."""
+        return None
+
     def outputs(self, time, channels: dict, p: dict, ctx: EffectContext) -> None:
         """Change sampled channels in place (sensor effects)."""

@@ -39,3 +39,6 @@ class BumpStop(Effect):
             x = (u - g) * (1.0 / s)
             return k * s * (esym.max(x, 0.0) + esym.log(1.0 + esym.exp(-esym.abs(x)))) - f0
         return [term]
+
+    def suspension_elements(self, susp, p, ctx):
+        return [("softplus", (float(p["stiffness"]), float(p["gap"]), float(p["smoothing"])))]

@@ -29,3 +29,9 @@ class DamperAsymmetry(Effect):
         r, v0, c = p["ratio"], p["velocity"], susp.damping
         dc = c * (1.0 - r) / (1.0 + r)   # c_comp = c + dc, c_reb = c - dc (v > 0: compression)
         return [lambda u, v: dc * esym.tanh(v * (1.0 / v0)) * v]
+
+    def suspension_elements(self, susp, p, ctx):
+        if susp.damping == 0.0 or p["ratio"] == 1.0:
+            return []
+        r, c = p["ratio"], susp.damping
+        return [("tanh_damper", (c * (1.0 - r) / (1.0 + r), float(p["velocity"])))]

@@ -53,3 +53,8 @@ class LeafFriction(Effect):
         esym = exudyn.symbolic
         F, v0 = p["force"], p["velocity"]
         return [lambda u, v: F * esym.tanh(v * (1.0 / v0))]
+
+    def suspension_elements(self, susp, p, ctx):
+        if susp.spring_type != "leaf" or p["force"] == 0.0:
+            return []
+        return [("tanh_force", (float(p["force"]), float(p["velocity"])))]
