@@ -2,7 +2,7 @@
 import glob, json, sys, math
 import numpy as np
 from scipy.signal import welch, butter, sosfreqz
-sys.path.insert(0, '/work/main')
+sys.path.insert(0, '.')   # run from the repository root
 import inverse.segmentation as S
 from drives.format import read_drive
 
