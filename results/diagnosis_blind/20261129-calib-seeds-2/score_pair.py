@@ -30,7 +30,10 @@ for fam in ("second", "nominal"):
     rows = {"two": [], "one": []}
     lines = []
     for c in res:
-        two = json.load(open(os.path.join(W, fam, f"case{c['case']:03d}-summary.json")))
+        f2 = os.path.join(W, fam, f"case{c['case']:03d}-summary.json")        # an archived set
+        if not os.path.exists(f2):
+            f2 = os.path.join(W, fam, f"case{c['case']:03d}-run", "summary.json")   # the work folder
+        two = json.load(open(f2))
         f1 = os.path.join(ONE, f"{fam}_case{c['case']:03d}", "summary.json")
         if not os.path.exists(f1):
             continue
