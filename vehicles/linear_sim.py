@@ -274,7 +274,6 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
     cc = np.array([c.damping for c in model.contacts])
     off = 0
     elements, Cq = suspension_elements(own, pl.eff, ctx)
-    newton_iter = 0
     if elements:
         from vehicles import suspension_forces as sf
         from vehicles.simulate import _failure_message
@@ -284,7 +283,7 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
         if unilateral:
             Bu = lm.Bk / kc[None, :]
             uni = (Bu, np.ascontiguousarray(Bu.T), own["f_static"] / kc, kc, cc, zr, zr_t, pl.dt)
-        X, off, newton_iter, failed = sf.integrate(Phi, Gam, x0, F, pl.n_sub, pl.n_out, Cq,
+        X, off, _iters, failed = sf.integrate(Phi, Gam, x0, F, pl.n_sub, pl.n_out, Cq,
                                                    kinds, prm, unilateral=uni)
         if failed >= 0 or X.shape[0] < pl.n_out:
             t_fail = (failed if failed >= 0 else X.shape[0] * pl.n_sub) * pl.dt
@@ -321,9 +320,7 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
     run_info = {"chassis": lm.chassis, "frame_segments": lm.meta["frame_segments"],
                 "frame_stiffness_factor": lm.meta["stiffness_factor"], "steps": pl.n_steps,
                 "solve_s": solve_s, "solve_cpu_s": solve_cpu, "n_dof": n,
-                "n_bodies": len(model.bodies), "newton": bool(elements),
-                "newton_iterations": int(newton_iter), "suspension_elements": len(elements),
-                "tyre_off_steps": off,
+                "n_bodies": len(model.bodies), "newton": bool(elements), "tyre_off_steps": off,
                 "tyre_contact_run": "unilateral" if unilateral else "linear",
                 "exudyn_version": exu.__version__,
                 "solver": "linear"}
