@@ -44,7 +44,8 @@ N_PARAMS = {"tanh_force": 2, "tanh_damper": 2, "softplus": 3}
 #: digits than double precision holds
 ATOL, RTOL = 1e-3, 1e-9
 #: iterations per step before the step counts as failed (the caller halves the step, as a
-#: failed Exudyn Newton run is retried); converged steps take 1-4
+#: failed Exudyn Newton run is retried).  Measured on class C and D windows (9.5 s): 1.0 (bump
+#: stop) to 3.2 (friction 12 kN at 5 mm/s, after one halving) iterations per step on average
 MAX_ITER = 60
 
 
