@@ -120,15 +120,10 @@ def integrate_unilateral(Phi, Gam, x0, F, Bu, rows, base, kc, cc, zr, zr_t, dt: 
     ``Bu`` (n, n_contacts): generalised force per newton under each tyre; ``rows``
     (n_contacts, n): contact heights from ``q``; ``base``: static deflections [m].
     Returns the states at every step and the number of steps with a correction."""
-    n = Bu.shape[0]
     nc = rows.shape[0]
     W = F[1:] @ Gam.T
     GB = Gam @ Bu
-    # [height; rate] of the contacts at the step's end, predicted from x = [q, v, a, ab]
-    P = np.zeros((2 * nc, x0.size))
-    P[:nc, :n], P[:nc, n:2 * n], P[:nc, 2 * n:3 * n] = rows, dt * rows, 0.5 * dt * dt * rows
-    P[nc:, n:2 * n], P[nc:, 2 * n:3 * n] = rows, dt * rows
-    PT = np.ascontiguousarray(P.T)
+    PT = contact_prediction(rows, dt, x0.size)
     X = np.empty((F.shape[0], x0.size))
     x = X[0] = x0
     PhiT = np.ascontiguousarray(Phi.T)
@@ -143,6 +138,17 @@ def integrate_unilateral(Phi, Gam, x0, F, Bu, rows, base, kc, cc, zr, zr_t, dt: 
             x = x + GB @ (np.where(d > 0.0, np.maximum(f_lin, 0.0), 0.0) - f_lin)
         X[i] = x
     return X, off
+
+
+def contact_prediction(rows, dt: float, size: int) -> np.ndarray:
+    """(size, 2 nc): the contacts' [height, rate] at a step's end as predicted from the state
+    ``x = [q, v, a, ab]`` at its start (``q + h v + h^2 a / 2`` and ``v + h a``, the rule of
+    Exudyn's unilateral prestep), transposed for ``x @ PT``."""
+    nc, n = rows.shape
+    P = np.zeros((2 * nc, size))
+    P[:nc, :n], P[:nc, n:2 * n], P[:nc, 2 * n:3 * n] = rows, dt * rows, 0.5 * dt * dt * rows
+    P[nc:, n:2 * n], P[nc:, 2 * n:3 * n] = rows, dt * rows
+    return np.ascontiguousarray(P.T)
 
 
 def applies(eff: dict, vp, chassis: str, stiffness_factor: float, newton) -> bool:

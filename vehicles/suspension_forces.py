@@ -200,20 +200,16 @@ def integrate(Phi, Gam, x0, F, every: int, n_out: int, Cq, kinds, prm, unilatera
     Gv = -Cq @ Gv_ @ Cq.T
     GsT = np.ascontiguousarray((Gam @ Cq.T).T)
     if unilateral is None:
-        nc = 0
         PT = np.zeros((x0.size, 0))
         GBT = np.zeros((0, x0.size))
         base = kc = cc = np.zeros(0)
         zr = zr_t = np.zeros((F.shape[0], 0))
-        dt = 0.0
         uni = False
     else:
+        from vehicles.linear_sim import contact_prediction
+
         Bu, rows, base, kc, cc, zr, zr_t, dt = unilateral
-        nc = rows.shape[0]
-        P = np.zeros((2 * nc, x0.size))
-        P[:nc, :n], P[:nc, n:2 * n], P[:nc, 2 * n:3 * n] = rows, dt * rows, 0.5 * dt * dt * rows
-        P[nc:, n:2 * n], P[nc:, 2 * n:3 * n] = rows, dt * rows
-        PT = np.ascontiguousarray(P.T)
+        PT = contact_prediction(rows, dt, x0.size)
         GBT = np.ascontiguousarray((Gam @ Bu).T)
         uni = True
     return _kernel(np.ascontiguousarray(Phi.T), W, np.ascontiguousarray(x0, dtype=float), int(every),

@@ -21,17 +21,16 @@ class DamperAsymmetry(Effect):
     nonlinear = True
 
     def suspension_terms(self, susp, p, ctx):
-        if susp.damping == 0.0 or p["ratio"] == 1.0:
-            return []
+        # the force of suspension_elements, as Exudyn's symbolic user function
         import exudyn
 
         esym = exudyn.symbolic
-        r, v0, c = p["ratio"], p["velocity"], susp.damping
-        dc = c * (1.0 - r) / (1.0 + r)   # c_comp = c + dc, c_reb = c - dc (v > 0: compression)
-        return [lambda u, v: dc * esym.tanh(v * (1.0 / v0)) * v]
+        return [(lambda u, v, dc=dc, v0=v0: dc * esym.tanh(v * (1.0 / v0)) * v)
+                for _kind, (dc, v0) in self.suspension_elements(susp, p, ctx)]
 
     def suspension_elements(self, susp, p, ctx):
         if susp.damping == 0.0 or p["ratio"] == 1.0:
             return []
         r, c = p["ratio"], susp.damping
-        return [("tanh_damper", (c * (1.0 - r) / (1.0 + r), float(p["velocity"])))]
+        dc = c * (1.0 - r) / (1.0 + r)   # c_comp = c + dc, c_reb = c - dc (v > 0: compression)
+        return [("tanh_damper", (dc, float(p["velocity"])))]

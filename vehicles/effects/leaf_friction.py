@@ -46,13 +46,12 @@ class LeafFriction(Effect):
     nonlinear = True
 
     def suspension_terms(self, susp, p, ctx):
-        if susp.spring_type != "leaf" or p["force"] == 0.0:
-            return []
+        # the force of suspension_elements, as Exudyn's symbolic user function
         import exudyn
 
         esym = exudyn.symbolic
-        F, v0 = p["force"], p["velocity"]
-        return [lambda u, v: F * esym.tanh(v * (1.0 / v0))]
+        return [(lambda u, v, F=F, v0=v0: F * esym.tanh(v * (1.0 / v0)))
+                for _kind, (F, v0) in self.suspension_elements(susp, p, ctx)]
 
     def suspension_elements(self, susp, p, ctx):
         if susp.spring_type != "leaf" or p["force"] == 0.0:
