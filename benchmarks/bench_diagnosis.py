@@ -69,6 +69,9 @@ def main(argv=None) -> int:
     ap.add_argument("--family", choices=("nominal", "second"), default="nominal",
                     help="truth family: the Exudyn truck plus one effect (nominal), or the "
                          "independently written truck with out-of-library differences (second)")
+    ap.add_argument("--effects", default=None, metavar="A,B",
+                    help="library effects the one-effect cases draw from, in turn (default: all the "
+                         "family carries, diagnosis.blind.FAMILIES): a set aimed at some effects")
     ap.add_argument("--rescore", action="store_true",
                     help="re-decide the saved cases of --out with the thresholds given below "
                          "(no simulation) and print the score")
@@ -139,6 +142,7 @@ def main(argv=None) -> int:
     out = run_blind(args.out, args.n, seed=args.seed, workers=args.workers, duration=args.duration,
                     settings=settings or None,
                     n_null=args.n if args.null_only else args.n_null, family=args.family,
+                    effects=args.effects.split(",") if args.effects else None,
                     progress=lambda m: print(m, flush=True))
     wall = time.perf_counter() - t
     sc = out["score"]

@@ -118,6 +118,9 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
         raise ValueError(f"family must be one of {', '.join(FAMILIES)}, got {family!r}")
     scenario, fam_effects = FAMILIES[family]
     names = list(effects or fam_effects)
+    bad = [e for e in names if e not in fam_effects]
+    if bad:
+        raise ValueError(f"family {family} carries {', '.join(fam_effects)}; not {', '.join(bad)}")
     if n_null is None:
         n_null = max(1, round(n / 5)) if family == "nominal" else n // 2
     off = 0 if family == "nominal" else 50000
@@ -457,8 +460,9 @@ def format_confusion(sc: dict) -> str:
 
 
 def run_blind(root, n: int = 30, *, seed: int = 0, workers: int = 2, duration=None, settings=None,
-              n_null: int | None = None, family: str = "nominal", progress=print) -> dict:
+              n_null: int | None = None, family: str = "nominal", effects=None, progress=print) -> dict:
     """Run ``n`` blind cases under ``root``; write ``root/blind.json`` and ``root/confusion.txt``.
+    ``effects``: the library effects the one-effect cases draw from (:func:`make_cases`).
 
     Cases already scored in ``root/blind.json`` are reused (the run can be resumed).
     """
@@ -471,7 +475,7 @@ def run_blind(root, n: int = 30, *, seed: int = 0, workers: int = 2, duration=No
     results = []
     t0 = _time.perf_counter()
     # case ids are stable; a redrawn road changes a case's dataset seed (recorded in results)
-    for case in make_cases(n, seed, n_null=n_null, family=family):
+    for case in make_cases(n, seed, n_null=n_null, family=family, effects=effects):
         r = done.get(case["case"])
         if r is None or r.get("value") != case["value"]:
             r = run_case(case, root, workers=workers, settings=settings, duration=duration,

@@ -1861,6 +1861,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     band_refit = bool(settings.pop("band_refit", BAND_REFIT))
     joint_band = bool(settings.pop("joint_band", JOINT_BAND))
     solver = str(settings.pop("solver", SIM_SOLVER))
+    from diagnosis.which import FOLD_EDGE_CHOICE
+    edge_choice = bool(settings.pop("fold_edge_choice", FOLD_EDGE_CHOICE))
     if solver not in SOLVERS:       # the integrators vehicles.simulate offers
         raise EroadInputError(f"solver must be {' or '.join(map(repr, SOLVERS))}, got {solver!r}")
     # one pool for the road fit, the ranking and the signatures; shut down however it ends
@@ -1922,7 +1924,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
             ranking = combine_folds(rank_effects_folds(cands, fit, simulate, splits, executor=ex,
                                                        terms=terms, progress=progress,
                                                        task_order=TASK_ORDER, **kw),
-                                    candidates=cands)
+                                    candidates=cands, edge_choice=edge_choice)
         timing["ranking_s"] = _time.perf_counter() - t
         # the winner's signature: its axle-to-body transmissibility on the
         # nominal model's road and seed, against the measurement (diagnosis.verdict); both the
@@ -1981,7 +1983,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
             "heldout_windows_s": [[float(edges[i]), float(edges[i + 1])] for i in range(n_windows)
                                   if i % 2 == 1],
             "noise_std": model.noise, "wheelbase_m": wheelbase, "quick": bool(quick), "seed": int(seed),
-            "workers": int(workers), "solver": model.solver, "candidates": [c.name for c in cands],
+            "workers": int(workers), "solver": model.solver, "fold_edge_choice": edge_choice,
+            "candidates": [c.name for c in cands],
             "search_ranges": search_ranges(cands),
             "own_side": side_rec,
             "signature_method": SIGNATURE_METHOD,

@@ -446,6 +446,10 @@ def _calibrated_value(summary: Mapping, verdict: str) -> str:
             folds = [f.get(eff, {}).get(p) for f in entry.get("parameters_per_fold") or []]
             fold_txt = (" (folds " + ", ".join(f"{x:.4g}" for x in folds if x is not None) + ")"
                         if len(folds) > 1 else "")
+            ch = entry.get("fold_choice") or {}
+            if fold_txt and ch.get("edge_discarded"):
+                fold_txt = (fold_txt[:-1] + f"; fold {int(ch['edge_fold']) + 1}'s value at the range edge set "
+                            "aside: the whole record fits the other fold's better)")
             parts.append(f"{eff}.{p} = {val:.4g}{unit}{fold_txt}")
     return (", calibrated " + "; ".join(parts)) if parts else ""
 

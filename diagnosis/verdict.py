@@ -513,8 +513,20 @@ def edge_parameters(params: Mapping, ranges: Mapping, tol: float = EDGE_TOL) -> 
 
 
 def _entry_edges(entry: Mapping, ranges: Mapping) -> list[str]:
-    folds = entry.get("parameters_per_fold") or [entry.get("parameters") or {}]
+    """The range edges of a winner's calibration: of every fold, except a fold at an edge whose
+    value the whole record fitted worse than the other fold's (``fold_choice``,
+    :func:`diagnosis.which.fold_edge_choice`: the value is then the other fold's)."""
+    folds = list(entry.get("parameters_per_fold") or [entry.get("parameters") or {}])
+    dropped = discarded_fold(entry)
+    if dropped is not None and len(folds) > dropped:
+        folds.pop(dropped)
     return sorted({e for p in folds for e in edge_parameters(p, ranges)})
+
+
+def discarded_fold(entry: Mapping) -> int | None:
+    """Index of the fold whose edge calibration the whole record set aside, else None."""
+    ch = entry.get("fold_choice") or {}
+    return int(ch["edge_fold"]) if ch.get("edge_discarded") else None
 
 
 def negligible(entry: Mapping, table: Mapping = None):
@@ -872,6 +884,13 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"itself on other road phases (up to {sig_max:.2g}), and its two-input "
             f"transmissibility agrees (mean z^2 {s2['chi2_nominal']:.2g} -> "
             f"{s2['chi2_model']:.2g}): corroborated, not 'clear'")
+    dropped = discarded_fold(win)
+    if dropped is not None:
+        wr = win["fold_choice"]["whole_record_gap"]
+        caveats.append(
+            f"; one fold's calibration lay at an edge of the search range, the other's inside, and "
+            f"the whole record fits the inside value better (gap summed over both window sets "
+            f"{wr[1 - dropped]:.3g} against {wr[dropped]:.3g}): the value is that fold's -- not 'clear'")
     z_abs = improvement_z(win)
     weak = z_abs is not None and z_abs < CLEAR_Z_MIN
     if weak:
@@ -895,7 +914,7 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     return dict(out, verdict=rv, confidence=conf, reason=reason,
                 identified=bool(rd.get("confidence") == "clear" and not edges and gap_present
                                 and not weak and not on_gap_alone and not on_signature
-                                and not st.corroborated))
+                                and not st.corroborated and dropped is None))
 
 
 def improvement_z(entry: Mapping) -> float | None:

@@ -433,6 +433,8 @@ class Entry:
     null_gaps: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     null_improvement: np.ndarray = field(default_factory=lambda: np.zeros(0))
     fold_effects: list = field(default_factory=list)
+    fold_gaps: list = field(default_factory=list)
+    fold_choice: dict | None = None
 
     @property
     def null_sd(self) -> float:
@@ -491,6 +493,8 @@ class Entry:
                                       if self.null_improvement.size else None),
             "null_improvement_sd": self.null_sd if self.null_improvement.size > 1 else None,
             **({"parameters_per_fold": self.fold_effects} if self.fold_effects else {}),
+            **({"gaps_per_fold": self.fold_gaps} if self.fold_gaps else {}),
+            **({"fold_choice": self.fold_choice} if self.fold_choice else {}),
             "per_band_before": [None if not np.isfinite(v) else float(v) for v in self.per_band_before],
             "per_band_after": [None if not np.isfinite(v) else float(v) for v in self.per_band_after],
         }
@@ -1391,8 +1395,55 @@ def fold_mean_effects(candidate: Candidate, fold_effects: Sequence[Mapping]) -> 
     return candidate.effects(u)
 
 
+#: A winner whose two folds disagree about a range edge -- one fold's calibration at an end of
+#: the search range, the other's inside -- takes the value that fits the WHOLE record better
+#: (:func:`fold_edge_choice`) instead of the folds' mean.  Why (2026-11-29, stop 60): on the saved
+#: blind sets every frame flexibility and bump stop of our truck with one fold at an edge had
+#: the other fold's value within x1.25 of the truth (frame 0.78, 0.87, 1.6, 1.8, 3.5: interior
+#: folds 0.76, 0.83, 1.58, 1.72, 2.97; bump stop 6.7, 7.5, 7.6 mm: 6.1-6.2 mm), and the mean of an
+#: edge value and a right one is neither (frame 0.28 for 0.78), so the verdict answered
+#: `unexplained`.  Measured on two of them (/work/fold60/curve.py, each fold's calibration gap on a
+#: value grid): the frame 0.78's edge fold had its lowest gap at 0.6-0.8 but the coarse grid
+#: stepped over that basin (0.1: 0.274, 0.4: 0.281, 0.78: 0.258); the bump stop 7.5 mm's edge fold
+#: is flat between 1 mm (0.540) and 7.5 mm (0.542) while the other fold's has 0.21 at 7.5 mm and
+#: 0.58 at 1 mm.  The whole record (each fold's value scored on its own calibration windows plus
+#: on the other fold's, the held-out windows) settles both.  The edge fold's value is kept in
+#: ``parameters_per_fold`` and the verdict says so (never 'clear'); where the edge value fits
+#: the whole record better, nothing changes (the edge stands).
+FOLD_EDGE_CHOICE = True
+#: unit-coordinate distance from a range end that counts as "at the edge" (as
+#: ``diagnosis.verdict.EDGE_TOL``)
+FOLD_EDGE_TOL = 0.02
+
+
+def fold_edge_choice(candidate: Candidate, fold_effects: Sequence[Mapping],
+                     fold_gaps: Sequence[Mapping], tol: float = FOLD_EDGE_TOL) -> dict | None:
+    """Where exactly one of two folds calibrated ``candidate`` at an end of its search range:
+    which fold's value fits the whole record better.
+
+    ``fold_gaps[f]``: ``calib_gap`` (fold f's value on its own calibration windows) and
+    ``heldout_gap`` (the same value on the other fold's windows, mean over the held-out seeds),
+    so each fold's sum scores its value on every window of the record.  Returns None when the
+    folds do not disagree about an edge, else ``{"edge_fold", "whole_record_gap" (per fold),
+    "edge_discarded"}`` -- the edge fold is discarded when the interior fold's sum is lower.
+    """
+    if len(fold_effects) != 2 or len(fold_gaps) != 2:
+        return None
+    at_edge = []
+    for fe in fold_effects:
+        us = [_unit(p, fe[candidate.name][p.name]) for p in candidate.params]
+        at_edge.append(any(u <= tol or u >= 1.0 - tol for u in us))
+    if sum(at_edge) != 1:
+        return None
+    whole = [float(g["calib_gap"]) + float(g["heldout_gap"]) for g in fold_gaps]
+    i_edge = at_edge.index(True)
+    return {"edge_fold": i_edge, "whole_record_gap": whole,
+            "edge_discarded": bool(whole[1 - i_edge] < whole[i_edge])}
+
+
 def combine_folds(rankings: Sequence[Ranking], z_paired: float | None = None,
-                  candidates: Sequence[Candidate] | None = None) -> Ranking:
+                  candidates: Sequence[Candidate] | None = None,
+                  edge_choice: bool = FOLD_EDGE_CHOICE) -> Ranking:
     """Two-fold (or k-fold) cross-fitting: rankings of the same candidates with the roles of
     calibration and held-out windows swapped, combined into one.
 
@@ -1403,7 +1454,11 @@ def combine_folds(rankings: Sequence[Ranking], z_paired: float | None = None,
     Acceptance and verdict as in :func:`rank_effects`.  Only singles present in every fold
     are combined (pairs are calibrated per fold and dropped).  ``effects`` is the folds'
     mean calibration (:func:`fold_mean_effects`) when ``candidates`` are given, else the
-    first fold's; ``fold_effects`` keeps every fold's.  The held-out gaps are each fold's at
+    first fold's -- except where one fold lies at a range edge and the other fold's value fits
+    the whole record better (:func:`fold_edge_choice`; ``edge_choice``, default
+    ``FOLD_EDGE_CHOICE``; ``diagnose(settings={"fold_edge_choice": False})`` switches it off): then
+    that value;
+    ``fold_effects`` keeps every fold's, ``fold_gaps`` their gaps, ``fold_choice`` the choice.  The held-out gaps are each fold's at
     its own calibration (cross-fitting); the mean calibration is what the signature, the
     report and the closed loop use.
     """
@@ -1427,13 +1482,17 @@ def combine_folds(rankings: Sequence[Ranking], z_paired: float | None = None,
         ll = sum(e.n_cells * math.log(e.heldout_gap_after / e.heldout_gap_before) for e in es)
         imp0 = np.mean([e.null_improvement for e in es], axis=0)
         fe = [e.effects for e in es]
+        fg = [{"calib_gap": float(e.calib_gap), "heldout_gap": e.heldout_gap_after} for e in es]
         eff = fold_mean_effects(by_name[name], fe) if name in by_name else es[0].effects
+        choice = fold_edge_choice(by_name[name], fe, fg) if edge_choice and name in by_name else None
+        if choice and choice["edge_discarded"]:
+            eff = fe[1 - choice["edge_fold"]]
         e = Entry(name, eff, es[0].k, float(np.mean([e.calib_gap for e in es])), before,
                   np.mean([e.after for e in es], axis=0), pb_before,
                   _nanmean([e.per_band_after for e in es]), n_total,
                   sum(e.n_evals for e in es), float(ll + es[0].k * math.log(n_total)),
                   floor=floor, null_gaps=np.mean([e.null_gaps for e in es], axis=0),
-                  null_improvement=imp0, fold_effects=fe)
+                  null_improvement=imp0, fold_effects=fe, fold_gaps=fg, fold_choice=choice)
         bn = bool(e.improvement > 0 and imp0.size > 1
                   and e.improvement - float(np.mean(imp0)) > z_paired * e.null_sd)
         entries.append(replace(e, beyond_noise=bn, accepted=bool(bn and e.delta_bic < 0)))

@@ -98,6 +98,23 @@ def test_edge_in_any_fold_counts():
     assert d["verdict"] == "unexplained" and d["edge"] == ["leaf_friction.force"]
 
 
+def test_an_edge_fold_the_whole_record_set_aside_does_not_count_but_is_never_clear():
+    """One fold at the range edge, the other inside, and the whole record fitting the inside
+    value better (``fold_choice``, made by diagnosis.which.fold_edge_choice): the value is the
+    inside fold's, the effect can be named, never 'clear' nor ``identified``, and the reason
+    says why.  Where the edge value fitted the record better the edge still counts."""
+    s = _summary(folds=[12000.0, 4000.0])
+    s["ranking"][0]["fold_choice"] = {"edge_fold": 0, "whole_record_gap": [0.66, 0.63],
+                                      "edge_discarded": True}
+    d = decide(s)
+    assert d["verdict"] == "leaf_friction" and d["confidence"] == "ambiguous"
+    assert d["edge"] == [] and not d["identified"]
+    assert "whole record fits the inside value better" in d["reason"] and "0.63 against 0.66" in d["reason"]
+    s["ranking"][0]["fold_choice"]["edge_discarded"] = False
+    d = decide(s)
+    assert d["verdict"] == "unexplained" and d["edge"] == ["leaf_friction.force"]
+
+
 def test_edge_parameters_linear_and_log():
     r = {"payload": {"mass": [-1000.0, 1000.0, False]}}
     assert edge_parameters({"payload": {"mass": -1000.0 + 2000 * EDGE_TOL / 2}}, r) == ["payload.mass"]

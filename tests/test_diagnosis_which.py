@@ -348,7 +348,12 @@ def test_two_folds_combine_the_held_out_evidence():
             vals = [fe[e.effect][pname] for fe in e.fold_effects]
             mean = (float(np.mean(vals)) if e.effect == "payload"
                     else float(np.exp(np.mean(np.log(vals)))))
+            ch = e.fold_choice or {}
+            if ch.get("edge_discarded"):   # one fold at an edge, set aside (fold_edge_choice)
+                mean = vals[1 - ch["edge_fold"]]
             assert val == pytest.approx(mean, rel=1e-12)
+            assert [g["calib_gap"] for g in e.fold_gaps] == pytest.approx(
+                [next(f for f in x.entries if f.effect == e.effect).calib_gap for x in rs])
             assert e0.effects == e.fold_effects[0]
             assert e.improvement == e0.improvement   # the held-out evidence is the folds'
 
@@ -598,3 +603,27 @@ def test_folds_in_one_batch_are_the_folds_one_after_the_other():
             assert ea.effects == eb.effects
             np.testing.assert_array_equal(ea.after, eb.after)
         np.testing.assert_array_equal(a.before, b.before)
+
+
+def test_fold_edge_choice_takes_the_value_the_whole_record_fits_better():
+    """diagnosis.which.fold_edge_choice: only where exactly one of two folds lies at a range end
+    (FOLD_EDGE_TOL in unit coordinates); each fold's value is scored on the whole record (its
+    calibration gap plus its held-out gap, the other fold's windows) and the edge fold is set
+    aside when the inside fold's sum is lower (the numbers of blind frame 1.6 of
+    results/diagnosis_blind/20261129-linear-fresh-40, fold gaps from /work/fold60/curve.py)."""
+    from diagnosis.which import fold_edge_choice
+
+    c = Candidate("frame_flex", (Param("stiffness_factor", 0.1, 100.0, log=True),))
+    fe = [{"frame_flex": {"stiffness_factor": 0.1}}, {"frame_flex": {"stiffness_factor": 1.585}}]
+    fg = [{"calib_gap": 0.4389, "heldout_gap": 0.2222}, {"calib_gap": 0.1790, "heldout_gap": 0.4480}]
+    ch = fold_edge_choice(c, fe, fg)
+    assert ch["edge_fold"] == 0 and ch["edge_discarded"]
+    assert ch["whole_record_gap"] == pytest.approx([0.6611, 0.6270])
+    # the edge value fits the record better: it stands
+    fg2 = [{"calib_gap": 0.40, "heldout_gap": 0.20}, {"calib_gap": 0.18, "heldout_gap": 0.45}]
+    assert not fold_edge_choice(c, fe, fg2)["edge_discarded"]
+    # no disagreement about an edge: no choice (both inside, both at an edge, one fold)
+    inside = [{"frame_flex": {"stiffness_factor": 0.8}}, {"frame_flex": {"stiffness_factor": 1.6}}]
+    both = [{"frame_flex": {"stiffness_factor": 0.1}}, {"frame_flex": {"stiffness_factor": 100.0}}]
+    assert fold_edge_choice(c, inside, fg) is None and fold_edge_choice(c, both, fg) is None
+    assert fold_edge_choice(c, fe[:1], fg[:1]) is None
