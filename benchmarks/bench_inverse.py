@@ -399,6 +399,7 @@ def score_run(ds: Path, scen: str, summ: dict) -> dict:
             r["oracle"] = o
             r["oracle_fit_window"] = ow
     case["fit_model"] = summ.get("fit", {}).get("model")
+    case["solver"] = summ.get("timing", {}).get("solver")
     loop = summ.get("closed_loop")
     if loop is not None:
         case["closed_loop"] = {k: loop.get(k) for k in ("verdict", "confidence", "effects", "corrected",
@@ -443,6 +444,9 @@ def main(argv=None) -> int:
     ap.add_argument("--no-polish", action="store_true", help="switch off the fit's polishing step")
     ap.add_argument("--segment-on", default="displacement", choices=["displacement", "axle_acc"],
                     help="as `eroad invert --segment-on`: what locates the segment boundaries")
+    ap.add_argument("--solver", default=None, choices=["linear", "exudyn"],
+                    help="integrator of the inversion's time simulations, as run_inversion(solver=...) "
+                         "(default inverse.truck.SIM_SOLVER)")
     ap.add_argument("--fit", default="linear", choices=["linear", "simulation"],
                     help="the fit's model, as `eroad invert --fit` (each record's fit_model field says which ran)")
     ap.add_argument("--known-noise", action="store_true",
@@ -529,7 +533,7 @@ def main(argv=None) -> int:
         t0 = time.perf_counter()
         inv = dict(workers=a.workers, seed=0, candidates=0, max_iter=a.max_iter, channels=a.channels,
                    force=True, polish=not a.no_polish, noise_sd=noise, fit_model=a.fit,
-                   segment_on=a.segment_on)
+                   segment_on=a.segment_on, solver=a.solver)
         if a.effects_auto:
             from diagnosis.closed_loop import invert_closed_loop
             dg = Path(a.diagnoses) / f"run-{seed}" / "diagnose" if a.diagnoses else None

@@ -84,6 +84,10 @@ def register(subparsers) -> None:
                         "suspension displacements in 3-20 Hz; the default) or 'axle_acc' (octave bands of "
                         "its axle accelerations: more boundaries on our own truck's drives, not on the "
                         "independently written one, so not the default); docs/inverse.md section 1")
+    p.add_argument("--solver", choices=("linear", "exudyn"), default=None,
+                   help="integrator of the time simulations: 'linear' (Exudyn's linearisation, the nonlinear "
+                        "suspension forces solved per step; the default) or 'exudyn' (every run in Exudyn); "
+                        "docs/inverse.md section 12")
     p.add_argument("--quick", action="store_true", help="few iterations and candidates (smoke runs)")
     p.add_argument("--json", action="store_true", help="print summary.json to stdout")
     p.add_argument("--quiet", action="store_true", help="no progress bar or progress lines")
@@ -97,7 +101,7 @@ def _cmd_invert(args) -> int:
     common = dict(segments=args.segments, workers=args.workers, seed=args.seed, quick=args.quick,
                   force=args.force, candidates=args.candidates, max_iter=args.max_iter,
                   channels=args.channels, noise_sd=_noise(args.noise), argv=sys.argv, fit_model=args.fit,
-                  selection=args.selection, road_model=args.road_model,
+                  selection=args.selection, road_model=args.road_model, solver=args.solver,
                   **({} if args.segment_on is None else {"segment_on": args.segment_on}))
     if len(args.dataset) > 1 or args.scheduler is not None:
         return _cmd_invert_many(args, common)

@@ -204,7 +204,8 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                   force: bool = False, candidates=None, max_iter=None, effects=None, chassis: str = "rigid",
                   channels=None, argv=None, polish: bool = True, noise_sd=None,
                   fit_model: str = "linear", selection: str = "linear", bar=None,
-                  road_model: str = "auto", model_form: str = "open", segment_on: str = "displacement") -> dict:
+                  road_model: str = "auto", model_form: str = "open", segment_on: str = "displacement",
+                  solver: str | None = None) -> dict:
     """Invert a dataset into the run folder ``out`` (see the module docstring).
 
     Parameters
@@ -273,6 +274,9 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
         What the segment boundaries are located on (:class:`inverse.pipeline.InversionConfig`):
         the reference axle's suspension displacements in 3-20 Hz (default) or the octave bands
         of its axle accelerations; recorded in ``summary["segmentation"]["boundaries_from"]``.
+    solver : {"linear", "exudyn"}, optional
+        Integrator of the time simulations (:data:`inverse.truck.SIM_SOLVER` when None);
+        recorded in config.toml and ``summary["timing"]["solver"]``.
 
     Returns
     -------
@@ -286,7 +290,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     from inverse.uncertainty import overall_fit_quality
     from inverse.sensitivity import FitConfig
     from inverse.spectral import ParamBounds
-    from inverse.truck import SIM_DX, TruckPredictRms, make_truck_simulator, nmax_cap
+    from inverse.truck import SIM_DX, SIM_SOLVER, TruckPredictRms, make_truck_simulator, nmax_cap
     from inverse.validation import response_table
 
     t0 = _time.perf_counter()
@@ -333,7 +337,9 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
     icfg = InversionConfig(k=segments, fit=fit_cfg, bounds=bounds, seed=seed, noise_psd=noise_psd,
                            fit_model=fit_model, model_form=model_form, calibration=ckey, segment_on=segment_on,
                            feature_spec=spec)
-    make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans), ref_axle=ref)
+    solver = SIM_SOLVER if solver is None else str(solver)
+    make_sim = make_truck_simulator(drive, effects=effects, chassis=chassis, channels=list(chans), ref_axle=ref,
+                                    solver=solver)
     predict = TruckPredictRms(drive.vehicle, tuple(seg_disp), chassis=chassis, effects=effects)
 
     pool = None
@@ -498,7 +504,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
                    "workers": workers, "seed": seed, "quick": quick, "candidates": n_cand, "max_iter": iters,
                    "chassis": chassis, "channels": list(fitted), "simulated_channels": list(chans),
                    "effects": json.dumps(effects or {}),
-                   "fit_model": fit_model, "selection": selection, "model_form": model_form,
+                   "fit_model": fit_model, "selection": selection, "model_form": model_form, "solver": solver,
                    "channel_set": cset, "uncertainty_calibration": ckey,
                    "simulator": {"dx_m": SIM_DX, "nmax_cap_cpm": nmax_cap(SIM_DX)},
                    "bounds": {k: list(getattr(bounds, k)) for k in ("Gq_n0", "w", "nmin", "nmax")}}
@@ -514,6 +520,7 @@ def run_inversion(dataset, out, *, segments=None, workers: int = 2, seed: int = 
             timing["report_s"] = timing["total_s"] - timing["fit_s"] - timing["selection_s"]
             timing["n_sims"] = int(inv.fit.n_sims + sel["n_simulated"])
             timing["workers"] = workers
+            timing["solver"] = solver
             summary["timing"] = timing
             summary["history"] = inv.fit.history
             write_json_atomic(tmp / "summary.json", summary)
