@@ -1397,19 +1397,17 @@ def fold_mean_effects(candidate: Candidate, fold_effects: Sequence[Mapping]) -> 
 
 #: A winner whose two folds disagree about a range edge -- one fold's calibration at an end of
 #: the search range, the other's inside -- takes the value that fits the WHOLE record better
-#: (:func:`fold_edge_choice`) instead of the folds' mean.  Why (2026-11-29, stop 60): on the saved
-#: blind sets every frame flexibility and bump stop of our truck with one fold at an edge had
-#: the other fold's value within x1.25 of the truth (frame 0.78, 0.87, 1.6, 1.8, 3.5: interior
-#: folds 0.76, 0.83, 1.58, 1.72, 2.97; bump stop 6.7, 7.5, 7.6 mm: 6.1-6.2 mm), and the mean of an
-#: edge value and a right one is neither (frame 0.28 for 0.78), so the verdict answered
-#: `unexplained`.  Measured on two of them (/work/fold60/curve.py, each fold's calibration gap on a
-#: value grid): the frame 0.78's edge fold had its lowest gap at 0.6-0.8 but the coarse grid
-#: stepped over that basin (0.1: 0.274, 0.4: 0.281, 0.78: 0.258); the bump stop 7.5 mm's edge fold
-#: is flat between 1 mm (0.540) and 7.5 mm (0.542) while the other fold's has 0.21 at 7.5 mm and
-#: 0.58 at 1 mm.  The whole record (each fold's value scored on its own calibration windows plus
-#: on the other fold's, the held-out windows) settles both.  The edge fold's value is kept in
-#: ``parameters_per_fold`` and the verdict says so (never 'clear'); where the edge value fits
-#: the whole record better, nothing changes (the edge stands).
+#: (:func:`fold_edge_choice`) instead of the folds' mean.  Why (stop 60): on the saved blind sets
+#: every frame flexibility and bump stop of our truck with one fold at an edge had the other
+#: fold's value within x1.25 of the truth (frame 0.78, 0.87, 1.6, 1.8, 3.5: inside folds 0.76,
+#: 0.83, 1.58, 1.72, 2.97; bump stop 6.7, 7.5, 7.6 mm: 6.1-6.2 mm), and the mean of an edge value
+#: and a right one is neither (frame 0.28 for 0.78), so the verdict answered `unexplained`.  Each
+#: fold's calibration gap on a value grid (results/diagnosis_blind/20261129-fold-edge-choice/
+#: curves.txt): the frame 0.78's edge fold has its lowest gap at 0.6-0.8, a basin its 6-point grid
+#: steps over; the bump stop 7.5 mm's edge fold is flat between 1 and 7.5 mm; the other folds
+#: have one clear basin at the truth.  Tested on two fresh sets stated in advance (same folder):
+#: the first gave nothing to gain (it fired on one no-effect drive, unchanged), the second named a
+#: bump stop that is `unexplained` without it, nothing lost, no new wrong name.
 FOLD_EDGE_CHOICE = True
 #: unit-coordinate distance from a range end that counts as "at the edge" (as
 #: ``diagnosis.verdict.EDGE_TOL``)
@@ -1456,11 +1454,10 @@ def combine_folds(rankings: Sequence[Ranking], z_paired: float | None = None,
     mean calibration (:func:`fold_mean_effects`) when ``candidates`` are given, else the
     first fold's -- except where one fold lies at a range edge and the other fold's value fits
     the whole record better (:func:`fold_edge_choice`; ``edge_choice``, default
-    ``FOLD_EDGE_CHOICE``; ``diagnose(settings={"fold_edge_choice": False})`` switches it off): then
-    that value;
-    ``fold_effects`` keeps every fold's, ``fold_gaps`` their gaps, ``fold_choice`` the choice.  The held-out gaps are each fold's at
-    its own calibration (cross-fitting); the mean calibration is what the signature, the
-    report and the closed loop use.
+    ``FOLD_EDGE_CHOICE``, off with ``diagnose(settings={"fold_edge_choice": False})``): then that
+    value.  ``fold_effects`` keeps every fold's, ``fold_gaps`` their gaps, ``fold_choice`` the
+    choice.  The held-out gaps are each fold's at its own calibration (cross-fitting); the
+    reported calibration is what the signature, the report and the closed loop use.
     """
     by_name = {c.name: c for c in (candidates or ())}
     rs = list(rankings)

@@ -610,7 +610,8 @@ def test_fold_edge_choice_takes_the_value_the_whole_record_fits_better():
     (FOLD_EDGE_TOL in unit coordinates); each fold's value is scored on the whole record (its
     calibration gap plus its held-out gap, the other fold's windows) and the edge fold is set
     aside when the inside fold's sum is lower (the numbers of blind frame 1.6 of
-    results/diagnosis_blind/20261129-linear-fresh-40, fold gaps from /work/fold60/curve.py)."""
+    results/diagnosis_blind/20261129-linear-fresh-40; fold gaps as in
+    results/diagnosis_blind/20261129-fold-edge-choice/curves.txt)."""
     from diagnosis.which import fold_edge_choice
 
     c = Candidate("frame_flex", (Param("stiffness_factor", 0.1, 100.0, log=True),))
