@@ -161,7 +161,7 @@ def test_truck_simulator_equals_vehicles_simulate_on_one_road():
     rounded up to the 0.025 m grid; the road is built here with roadlib.segments from the
     hand lengths and the same seed.  The record is the simulation's samples 400..1199.
 
-    Same road, model and step, so only round-off separates the two (the simulator's
+    Same road, model, integrator and step, so only round-off separates the two (the simulator's
     fs = 1/mean(diff(t)) is 199.9999999999998 Hz for this time axis): agreement within
     1e-8 of each channel's sd (measured 3e-11).  The speed 9.137 m/s is deliberately not
     commensurate with the road grid: at 9 m/s the step (22.5 mm) puts tyres exactly on
@@ -190,7 +190,9 @@ def test_truck_simulator_equals_vehicles_simulate_on_one_road():
     np.testing.assert_allclose(lay["x_bounds"], [0.0, x_b, length], rtol=0, atol=1e-9)
     road = segmented_surface([RoadSegment(Gq_n0=p[0], share=s, w=p[1], nmin=p[2], nmax=p[3], lam=1.0)
                               for p, s in zip(P2, (x_b, length - x_b))], length, 3.0, 0.025, 0.1, seed=5)
-    ref = simulate(VEHICLE, road, speed=v, duration=duration, fs_out=fs, x_start=x_front0, seed=0)
+    # the same integrator as the simulator's (inverse.truck.SIM_SOLVER unless given)
+    ref = simulate(VEHICLE, road, speed=v, duration=duration, fs_out=fs, x_start=x_front0, seed=0,
+                   solver=sim.solver)
     first = int(round(runin * fs))
     for c in channels:
         r = np.asarray(ref.channels[c])[first:first + n]
