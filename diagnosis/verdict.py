@@ -76,6 +76,10 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+# a calibrated parameter within EDGE_TOL of its search range's ends (unit coordinates) is "at the
+# edge": defined beside the ranking's fold choice, which must agree with the verdict on it
+from diagnosis.which import EDGE_TOL
+
 #: least share of the held-out gap above a correct model's that a named effect explains.
 #: Set on the 18-drive blind set of the independent truth family (the rule of
 #: ``diagnosis.blind.sweep``: no confident wrong answer, then the mean of the right-effect
@@ -140,9 +144,6 @@ NEGLIGIBLE = {"speed_scale": ("factor", 1.0, 0.01)}
 #: independent truck, checked on the nominal family (no drive meets it):
 #: docs/diagnosis.md "Named on the signature".
 SIGNATURE_STRONG = 0.5
-#: a calibrated parameter within this share of its search range (unit coordinates, log
-#: where searched in log) of either end is "at the edge"
-EDGE_TOL = 0.02
 #: which axle-to-body transmissibility the signature test (3.) uses: ``"two_input"``
 #: (:func:`diagnosis.compare.transmissibility_two_input`: body acceleration of a station on
 #: BOTH axle accelerations of that station, which does not depend on the road's cross-track

@@ -1409,13 +1409,15 @@ def fold_mean_effects(candidate: Candidate, fold_effects: Sequence[Mapping]) -> 
 #: the first gave nothing to gain (it fired on one no-effect drive, unchanged), the second named a
 #: bump stop that is `unexplained` without it, nothing lost, no new wrong name.
 FOLD_EDGE_CHOICE = True
-#: unit-coordinate distance from a range end that counts as "at the edge" (as
-#: ``diagnosis.verdict.EDGE_TOL``)
-FOLD_EDGE_TOL = 0.02
+#: a calibrated parameter within this share of its search range (unit coordinates, log where
+#: searched in log) of either end is "at the edge" -- here and in the verdict
+#: (``diagnosis.verdict.EDGE_TOL`` is this constant), so the fold choice and the verdict agree
+#: on which fold lies at an edge
+EDGE_TOL = 0.02
 
 
 def fold_edge_choice(candidate: Candidate, fold_effects: Sequence[Mapping],
-                     fold_gaps: Sequence[Mapping], tol: float = FOLD_EDGE_TOL) -> dict | None:
+                     fold_gaps: Sequence[Mapping], tol: float = EDGE_TOL) -> dict | None:
     """Where exactly one of two folds calibrated ``candidate`` at an end of its search range:
     which fold's value fits the whole record better.
 

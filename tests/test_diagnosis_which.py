@@ -607,7 +607,7 @@ def test_folds_in_one_batch_are_the_folds_one_after_the_other():
 
 def test_fold_edge_choice_takes_the_value_the_whole_record_fits_better():
     """diagnosis.which.fold_edge_choice: only where exactly one of two folds lies at a range end
-    (FOLD_EDGE_TOL in unit coordinates); each fold's value is scored on the whole record (its
+    (EDGE_TOL in unit coordinates); each fold's value is scored on the whole record (its
     calibration gap plus its held-out gap, the other fold's windows) and the edge fold is set
     aside when the inside fold's sum is lower (the numbers of blind frame 1.6 of
     results/diagnosis_blind/20261129-linear-fresh-40; fold gaps as in
