@@ -213,6 +213,19 @@ def loop_channels(verdict: str | None, channels=None, available=None) -> tuple:
     return None, ""
 
 
+def loop_verdict(summary: dict) -> str | None:
+    """The verdict the loop chooses its channels and model form by: the diagnosis's, except that
+    an effect named as a vehicle difference (``verdict_detail.named_on == "vehicle_share"``:
+    a vehicle effect explaining most of the gap whose transmissibility does not confirm it,
+    ``diagnosis.verdict.VEHICLE_SHARE_MIN``) is fitted as the ``unexplained`` drive it was
+    before the verdict named it: axle 3's accelerations, the unexplained model-form term. The
+    effect and its value are the same either way (:func:`closest_vehicle_effect` corrected with
+    it), so the loop's inversions of those drives are unchanged."""
+    if (summary.get("verdict_detail") or {}).get("named_on") == "vehicle_share":
+        return "unexplained"
+    return summary.get("verdict")
+
+
 def singled_out(summary: dict) -> bool:
     """Whether the diagnosis singled its named effect out: confidence ``clear``, or
     ``identified`` (a remainder beside an undisputed effect)."""
@@ -335,18 +348,18 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
         dsum = _diagnosis_summary(dataset, work, diagnosis, True, workers, quick, seed, progress, out)
         effects, reason = effects_from_diagnosis(dsum)
         from drives.format import read_drive
-        inversion["channels"], why = loop_channels(dsum.get("verdict"), inversion.get("channels"),
+        inversion["channels"], why = loop_channels(loop_verdict(dsum), inversion.get("channels"),
                                                    read_drive(dataset).channel_names)
         reason = f"{reason}; {why}" if why else reason
         progress(f"closed loop: {reason}")
         progress("closed loop: nominal inversion ...")
         nominal = run_inversion(dataset, work / "nominal", workers=workers, seed=seed, quick=quick,
-                                argv=argv, model_form=model_form(dsum.get("verdict"), False), **inversion)
+                                argv=argv, model_form=model_form(loop_verdict(dsum), False), **inversion)
         if effects:
             progress("closed loop: corrected inversion ...")
             chosen = run_inversion(dataset, work / "corrected", workers=workers, seed=seed, quick=quick,
                                    effects=effects, argv=argv,
-                                   model_form=model_form(dsum.get("verdict"), True, singled_out(dsum)),
+                                   model_form=model_form(loop_verdict(dsum), True, singled_out(dsum)),
                                    **inversion)
             main = work / "corrected"
             (work / "nominal").rename(main / "nominal")
