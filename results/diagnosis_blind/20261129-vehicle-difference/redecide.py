@@ -1,4 +1,6 @@
-"""Re-decide saved blind summaries with the vehicle-difference rule on (default) and off
+"""python redecide.py [ROOT ...]  (default: results/diagnosis_blind; a bench --out folder works too)
+
+Re-decide saved blind summaries with the vehicle-difference rule on (default) and off
 (vehicle_share=None); print every drive whose verdict changes, and the counts."""
 import json, glob, os, sys, collections
 from diagnosis import verdict as V
@@ -10,7 +12,9 @@ for root in roots:
         try: b = json.load(open(bj))
         except Exception: continue
         for r in b.get("results", []):
-            sp = f"{d}/case{r['case']:03d}-summary.json"
+            sp = f"{d}/case{r['case']:03d}-summary.json"          # a committed set
+            if not os.path.exists(sp):
+                sp = f"{d}/case{r['case']:03d}-run/summary.json"  # a bench work folder
             if not os.path.exists(sp): continue
             s = json.load(open(sp))
             try:
