@@ -104,6 +104,10 @@ class StudyConfig:
         Vehicle id or TOML file.
     quick : bool
         The CI smoke configuration.
+    solver : {"linear", "exudyn"}
+        Integrator of each drive (``studies.figure11.simulate_tractor``): the linear model
+        stepped with Exudyn's scheme (default; the study's vehicle is linear but for tyre
+        lift-off, which it corrects as Exudyn does) or Exudyn itself.
     """
 
     frames: tuple = FRAME_FACTORS
@@ -115,6 +119,7 @@ class StudyConfig:
     t_skip: float = 1.0
     vehicle: str = DEFAULT_VEHICLE
     quick: bool = False
+    solver: str = "linear"
 
     def to_dict(self) -> dict:
         """Plain dict (config.toml; ``duration`` omitted when None)."""
@@ -123,7 +128,7 @@ class StudyConfig:
                 "seed": int(self.seed), "speed_mps": float(self.speed),
                 "duration_s": None if self.duration is None else float(self.duration),
                 "t_skip_s": float(self.t_skip), "vehicle": str(self.vehicle),
-                "quick": bool(self.quick),
+                "quick": bool(self.quick), "solver": str(self.solver),
                 "bands_hz": [list(b) for b in BANDS]}
 
 
@@ -318,7 +323,7 @@ def study_cases(config: StudyConfig, roads: list[dict]) -> list[dict]:
                               "speed": float(config.speed),
                               "duration": None if config.duration is None
                               else float(config.duration),
-                              "t_skip": float(config.t_skip)})
+                              "t_skip": float(config.t_skip), "solver": str(config.solver)})
     return cases
 
 
@@ -341,7 +346,8 @@ def chassis_case(case: dict) -> dict:
         ``vehicle`` (id or TOML file), ``frame`` (stiffness factor [-] or
         ``"rigid"``), ``mount`` (DCDC mount stiffness factor [-]), ``road`` (a spec of
         :func:`road_specs`), ``road_index``, ``speed`` [m/s], ``duration`` [s] or None
-        (as long as the road allows), ``t_skip`` [s].
+        (as long as the road allows), ``t_skip`` [s], ``solver`` ("linear" or "exudyn";
+        absent: "exudyn", as cases made before it).
 
     Returns
     -------
@@ -368,7 +374,8 @@ def chassis_case(case: dict) -> dict:
         raise EroadInputError(f"road too short for the study: {road.length:.1f} m allow "
                               f"{t_max:.1f} s at {speed:g} m/s")
     d = drive_base_motion(vp, road, speed=speed, duration=dur, chassis=chassis,
-                          frame_factor=ff, t_skip=float(case["t_skip"]))
+                          frame_factor=ff, t_skip=float(case["t_skip"]),
+                          solver=case.get("solver", "exudyn"))
     m, fs = d["motion"], d["fs"]
     table = motion_band_table(m, fs)
     bands = table[[band_label(b) for b in BANDS]].to_numpy(float)

@@ -205,7 +205,7 @@ def max_duration(road, vp, speed: float) -> float:
 
 
 def simulate_tractor(vp, road, *, speed: float, duration: float, chassis: str = "flexible",
-                     frame_factor: float = 1.0, fs_out: float = 200.0):
+                     frame_factor: float = 1.0, fs_out: float = 200.0, solver: str = "exudyn"):
     """Simulate the tractor (flexible frame scaled by ``frame_factor``, or rigid).
 
     Parameters
@@ -221,6 +221,10 @@ def simulate_tractor(vp, road, *, speed: float, duration: float, chassis: str = 
         Frame stiffness factor [-] (flexible chassis, ``frame_flex`` effect).
     fs_out : float, optional
         Output sample rate [Hz].
+    solver : {"exudyn", "linear"}, optional
+        Integrator (``vehicles.simulate.simulate``): Exudyn, or the linear model stepped with
+        Exudyn's scheme (``vehicles.linear_sim``; the DCDC body and the flexible frame
+        included, tyre lift-off corrected), about 10x faster.
 
     Returns
     -------
@@ -238,7 +242,7 @@ def simulate_tractor(vp, road, *, speed: float, duration: float, chassis: str = 
     effects = {"frame_flex": {"stiffness_factor": float(frame_factor)}} \
         if chassis == "flexible" else None
     return simulate(vp, road, speed=speed, duration=duration, chassis=chassis, effects=effects,
-                    fs_out=fs_out)
+                    fs_out=fs_out, solver=solver)
 
 
 def static_dcdc_rotation(vp, chassis: str = "flexible", frame_factor: float = 1.0) -> np.ndarray:
@@ -411,7 +415,7 @@ def kinematics_check(result, vp, chassis: str = "flexible", frame_factor: float 
 
 def drive_base_motion(vp, road, *, speed: float, duration: float, chassis: str = "flexible",
                       frame_factor: float = 1.0, t_skip: float = 1.0, method: str = "linear",
-                      check: bool = False) -> dict:
+                      check: bool = False, solver: str = "exudyn") -> dict:
     """One drive: simulate, solve the base motion from the DCDC points (paper method).
 
     Parameters
@@ -431,6 +435,8 @@ def drive_base_motion(vp, road, *, speed: float, duration: float, chassis: str =
         Kinematics method (default the paper's ``"linear"``).
     check : bool, optional
         Also run :func:`kinematics_check` on the drive.
+    solver : {"exudyn", "linear"}, optional
+        Integrator of the drive (:func:`simulate_tractor`).
 
     Returns
     -------
@@ -440,7 +446,7 @@ def drive_base_motion(vp, road, *, speed: float, duration: float, chassis: str =
         or None).
     """
     res = simulate_tractor(vp, road, speed=speed, duration=duration, chassis=chassis,
-                           frame_factor=frame_factor)
+                           frame_factor=frame_factor, solver=solver)
     pts = dcdc_points(vp)
     dy, dz = _point_channels(res, pts.shape[0])
     keep = res.time >= t_skip - 1e-9

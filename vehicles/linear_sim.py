@@ -12,8 +12,11 @@ model, so a drive costs a matrix product per step instead of an Exudyn solve.
 
 What it is not: an approximation in frequency (no FFT, no periodic wrap, the run-in and the
 speed profile are those of the time simulation) nor a replacement where the model is not
-linear beyond local suspension forces: forced Newton iterations, effects whose forces have no
-element kind and vehicles with a DCDC body go to Exudyn (:func:`applies`).  Tyre lift-off is
+linear beyond local suspension forces: forced Newton iterations and effects whose forces have no
+element kind go to Exudyn (:func:`applies`). A vehicle with a DCDC body (the electric tractor) is
+covered: its four top-face points are output rows of the linear model and the top's rigid-body
+motion (``SimResult.extra["dcdc_ref"]``) is read from its rows as Exudyn's run reads it
+(:func:`dcdc_reference`).  Tyre lift-off is
 not a reason: the unilateral run corrects the tyre forces step by step exactly as Exudyn's
 does (:func:`integrate_unilateral`).  Nor are the library's nonlinear effects (leaf friction,
 asymmetric dampers, bump stops): each is a force on one axle side that depends on that side's
@@ -45,6 +48,7 @@ import numpy as np
 
 from vehicles.effects import EFFECTS
 from vehicles.effects.base import Effect
+from vehicles.linear import DCDC_MOTIONS
 
 #: linear models kept per process (key: the configured vehicle and chassis)
 CACHE_SIZE = 16
@@ -157,7 +161,7 @@ def applies(eff: dict, vp, chassis: str, stiffness_factor: float, newton) -> boo
     with :meth:`~vehicles.effects.base.Effect.suspension_elements`, solved per step) allowed."""
     from vehicles.simulate import STIFF_FRAME_NEWTON
 
-    if newton or vp.dcdc is not None:
+    if newton:
         return False
     if chassis == "flexible" and stiffness_factor > STIFF_FRAME_NEWTON:
         return False
@@ -225,13 +229,20 @@ def model_for(vp, chassis: str, frame_segments, stiffness_factor: float):
 
 def _static_offsets(own, ref, names) -> dict:
     """Per channel: the configured vehicle's static value against the reference vehicle's
-    (what a payload's sag adds to a suspension displacement read from the nominal zero)."""
+    (what a payload's sag adds to a suspension displacement read from the nominal zero, or to
+    a DCDC point's position read from the reference vehicle's static point, as
+    :func:`vehicles.simulate.simulate` reads both)."""
     from vehicles.simulate import _static_point, output_points
 
     own, ref = own["lm"].model, ref["lm"].model
-    pts = {ch: (body, wp) for ch, kind, body, wp in output_points(own) if kind == "z_pos"}
+    pts = {ch: (body, wp) for ch, kind, body, wp in output_points(own) if kind in ("z_pos", "yz_pos")}
     off = {}
     for name in names:
+        if name.startswith(("dcdc_y_", "dcdc_z_")):
+            body, wp = pts[name[len("dcdc_y_"):]]
+            axis = 1 if name.startswith("dcdc_y_") else 2
+            off[name] = float(_static_point(own, body, wp)[axis] - _static_point(ref, body, wp)[axis])
+            continue
         if not name.startswith("susp_disp_"):
             continue
         tag = name[len("susp_disp_"):]
@@ -241,6 +252,25 @@ def _static_offsets(own, ref, names) -> dict:
             d += sign * (_static_point(own, body, wp)[2] - _static_point(ref, body, wp)[2])
         off[name] = d
     return off
+
+
+def dcdc_reference(own, ref, rows: dict, q, v, a) -> dict:
+    """The DCDC top's rigid-body motion (``SimResult.extra`` ``dcdc_ref`` ...) from the linear
+    model's output rows ``rows`` (``vehicles.linear.DCDC_MOTIONS``: the top-face centre's
+    displacement and the block's small global rotation, each from the configured vehicle's
+    static state) and the states ``q``, ``v``, ``a``; read, as Exudyn's run reads them, from the
+    REFERENCE vehicle's static point and orientation (the two statics differ where an effect
+    changes the vehicle)."""
+    from vehicles.simulate import _small_rotation, _static_point, dcdc_extra, dcdc_top
+
+    mo, mr = own["lm"].model, ref["lm"].model
+    d = mo.vp.dcdc
+    T = np.vstack([rows[f"dcdc_T{c}"] for c in "xyz"])
+    R = np.vstack([rows[f"dcdc_R{c}"] for c in "xyz"])
+    top = dcdc_top(d)
+    p_off = _static_point(mo, "dcdc", top) - _static_point(mr, "dcdc", top)
+    r_off = _small_rotation(mo.static["dcdc"][1][None], mr.static["dcdc"][1])[0]
+    return dcdc_extra(d, q @ T.T + p_off, q @ R.T + r_off, a @ T.T, a @ R.T, v @ R.T)
 
 
 def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool = False):
@@ -318,8 +348,13 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
     if offsets is None:
         offsets = own["offsets"][ref["key"]] = _static_offsets(own, ref, lm.channel_names)
     channels = {}
+    ref6 = {}
     for o in lm.outputs:
+        if o.name in DCDC_MOTIONS:      # the DCDC top's rigid-body motion: an extra, as in Exudyn's run
+            ref6[o.name] = o.row
+            continue
         channels[o.name] = (q if o.order == 0 else a) @ o.row + offsets.get(o.name, 0.0)
+    extra = {} if not ref6 else dcdc_reference(own, ref, ref6, q, X[:, n:2 * n], a)
     time = np.arange(pl.n_out) * pl.t_out
     channels["speed"] = pl.profile.speed(time)
     zc = q @ own["contact_rows"].T
@@ -330,5 +365,5 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
                 "tyre_contact_run": "unilateral" if unilateral else "linear",
                 "exudyn_version": exu.__version__,
                 "solver": "linear"}
-    return _finish_result(pl, channels, {}, zc, zr, zr_t, kc, cc, own["f_static"], unilateral, run_info,
+    return _finish_result(pl, channels, extra, zc, zr, zr_t, kc, cc, own["f_static"], unilateral, run_info,
                           road, y_offset, wall0, cpu0, out_cpu0)

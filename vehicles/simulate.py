@@ -805,18 +805,32 @@ def _finish_result(pl: _DrivePlan, channels: dict, extra: dict, zc, zr, zr_t, kc
 
 def _dcdc_reference(model, ref_model, data) -> dict:
     d = model.vp.dcdc
-    top = np.array([d.x, d.y, d.z_base + d.height])
+    top = dcdc_top(d)
     b = model.body("dcdc")
     P, A = _body_points(data, (top - b.cog)[None, :])
     pos, acc = P[:, :, 0], A[:, :, 0]
     p_ref = _static_point(ref_model, "dcdc", top)
     R0 = ref_model.static["dcdc"][1]
     rot = _small_rotation(data["RotationMatrix"], R0)
+    return dcdc_extra(d, pos - p_ref, rot, acc, data["AngularAcceleration"], data["AngularVelocity"])
+
+
+def dcdc_top(d) -> np.ndarray:
+    """The DCDC top-face centre, design position [m] (``vp.dcdc``)."""
+    return np.array([d.x, d.y, d.z_base + d.height])
+
+
+def dcdc_extra(d, pos, rot, acc, ang_acc, ang_vel) -> dict:
+    """``SimResult.extra``'s DCDC entries, alike from either integrator: the top-face centre's
+    translation from the reference vehicle's static point and small global rotation from its
+    static orientation (``dcdc_ref``, Tx Ty Tz [m] Rx Ry Rz [rad]), their accelerations
+    (``dcdc_ref_acc``), the angular velocity (``dcdc_ref_vel``) and the four top-face points in
+    the block's frame (``dcdc_points``)."""
     pts = np.array([[sx * d.point_x, sy * d.point_y, 0.0]
                     for sx, sy in ((1, 1), (1, -1), (-1, -1), (-1, 1))])
-    return {"dcdc_ref": np.hstack([pos - p_ref, rot]),
-            "dcdc_ref_acc": np.hstack([acc, data["AngularAcceleration"]]),
-            "dcdc_ref_vel": data["AngularVelocity"].copy(),
+    return {"dcdc_ref": np.hstack([pos, rot]),
+            "dcdc_ref_acc": np.hstack([acc, ang_acc]),
+            "dcdc_ref_vel": np.array(ang_vel, dtype=float, copy=True),
             "dcdc_points": pts,
             "dcdc_ref_columns": np.array(["Tx", "Ty", "Tz", "Rx", "Ry", "Rz"])}
 
