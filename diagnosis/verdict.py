@@ -133,9 +133,10 @@ FULL_GAP_Z = 2.0
 #: tyre enveloping: a road-band misfit looks like a low-pass) or vehicle effects explaining
 #: less than half the gap.  The same rule and share the closed loop has corrected with since
 #: 2026-11-28 (``diagnosis.closed_loop.CLOSEST_SHARE_MIN``), now said by the verdict itself.
-#: Re-decided on the 931 saved blind diagnoses: 14 right names gained, 0 wrong (the nearest
-#: wrong: a damper asymmetry at 0.49 and a frame flexibility at 0.46 of the gap); tested on
-#: fresh drives after (docs/diagnosis.md, "Named as a vehicle difference").  None: off.
+#: Re-decided on the 931 saved blind diagnoses: 13 right names gained, 0 wrong (the nearest
+#: wrong: a damper asymmetry at 0.49 and a frame flexibility at 0.46 of the gap); on 56 fresh
+#: drives afterwards it changed no verdict, so it is not tested fresh (docs/diagnosis.md, "A
+#: vehicle effect taking most of the gap, named as a vehicle difference").  None: off.
 VEHICLE_SHARE_MIN = 0.6
 #: the smallest deviation from "no effect" the verdict names, per effect: effect ->
 #: (parameter, neutral value, smallest relative deviation).  A winner calibrated closer to

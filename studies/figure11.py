@@ -224,7 +224,8 @@ def simulate_tractor(vp, road, *, speed: float, duration: float, chassis: str = 
     solver : {"exudyn", "linear"}, optional
         Integrator (``vehicles.simulate.simulate``): Exudyn, or the linear model stepped with
         Exudyn's scheme (``vehicles.linear_sim``; the DCDC body and the flexible frame
-        included, tyre lift-off corrected), about 10x faster.
+        included, tyre lift-off corrected), 3-5x faster per drive (0.32 -> 0.06 s for 10 s on a
+        class C road; 2.4 -> 0.6 s for 30 s on a road that lifts tyres).
 
     Returns
     -------
