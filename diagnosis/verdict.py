@@ -904,8 +904,8 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"beyond it, or this drive's noise) is not known -- not 'clear'")
     if as_vehicle:
         caveats.append(
-            f"; named as a vehicle difference: it changes the vehicle itself and explains "
-            f"{share:.0%} of the held-out gap above a correct model's with no rival close, but its "
+            f"; named as a vehicle difference: it changes the vehicle itself, explains most of the "
+            f"gap (at least {vehicle_share:.0%} asked) and no rival comes close, but its "
             f"{what} does not confirm it (mean z^2 {c1:.2g}, nominal {c0:.2g}, at most "
             f"{sig_max:.2g} asked): the nearest description of the vehicle the library has, and "
             f"something beyond it may remain -- not 'clear'")
