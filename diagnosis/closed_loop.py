@@ -128,14 +128,14 @@ def closest_vehicle_effect(summary: dict) -> tuple[dict, float] | None:
 
     Returns ``({effect: {parameter: value}}, explained share)`` or None.
     """
-    from vehicles.effects import EFFECTS
+    from diagnosis.verdict import acts_on_vehicle
 
     if summary.get("verdict") != "unexplained":
         return None
     detail = summary.get("verdict_detail") or {}
     name = detail.get("closest")
     share = detail.get("explained_share")
-    if (name not in EFFECTS or not EFFECTS[name].acts_on_vehicle or detail.get("ranking_confidence") != "clear"
+    if (not acts_on_vehicle(name) or detail.get("ranking_confidence") != "clear"
             or share is None or share < CLOSEST_SHARE_MIN or detail.get("edge")):
         return None
     params = _ranking_parameters(summary, name)

@@ -955,8 +955,8 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
 def acts_on_vehicle(effect: str) -> bool:
     """Whether a ranked effect changes the vehicle itself (``vehicles.effects``
     ``Effect.acts_on_vehicle``: suspension terms or masses), not the road the tyres see or the
-    recorded channels; a pair ``a+b`` or an effect the library does not hold: False (as the
-    closed loop's ``closest_vehicle_effect``)."""
+    recorded channels; a pair ``a+b``, None or an effect the library does not hold: False. The one
+    test of it for the verdict and the closed loop (``closest_vehicle_effect``)."""
     from vehicles.effects import EFFECTS
 
     return effect in EFFECTS and bool(EFFECTS[effect].acts_on_vehicle)
