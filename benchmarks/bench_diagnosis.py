@@ -80,7 +80,7 @@ def main(argv=None) -> int:
                          "diagnosis.blind.SWEEP_GRID) and check them on the saved cases of OTHER")
     ap.add_argument("--band-refit", action="store_true",
                     help="refit the road band with the ranking's first effect in the truck "
-                         "(diagnosis.pipeline.refit_band); each case keeps the first pass's "
+                         "(diagnosis.road_fit.refit_band); each case keeps the first pass's "
                          "verdict beside the final one")
     ap.add_argument("--joint-band", action="store_true",
                     help="choose the road band jointly with the effect (diagnosis.pipeline."

@@ -85,7 +85,7 @@ def trial_cut(sig, grid, top: float) -> dict:
     sig : diagnosis.signals.Signals
         The measurement (axle accelerations ``axle_acc_*`` and speed).
     grid : sequence of float
-        Candidate cuts [cycles/m] (``diagnosis.pipeline.NMAX_GRID``).
+        Candidate cuts [cycles/m] (``diagnosis.road_fit.NMAX_GRID``).
     top : float
         The default road's top frequency; only cuts below it are tried.
 

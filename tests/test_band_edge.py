@@ -17,7 +17,7 @@ ACC_NOISE, DISP_NOISE = 0.03, 1.0e-4
 
 
 def _record(nmax, seed, effects=None):
-    from diagnosis.pipeline import TruckModel
+    from diagnosis.truck_model import TruckModel
     from diagnosis.signals import Signals
 
     t = np.arange(int(DUR * FS)) / FS
@@ -33,7 +33,7 @@ def _record(nmax, seed, effects=None):
 
 def _trial(sig):
     from diagnosis.band_edge import trial_cut
-    from diagnosis.pipeline import NMAX_GRID, ROAD_NMAX
+    from diagnosis.road_fit import NMAX_GRID, ROAD_NMAX
 
     return trial_cut(sig, NMAX_GRID, ROAD_NMAX)
 

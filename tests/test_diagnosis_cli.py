@@ -140,7 +140,7 @@ def test_blind_cases(tmp_path):
 
 
 def test_per_model_nuisances_tilt_and_noise():
-    """The nuisances profiled per model and window (pipeline.window_tilt, apply_tilt,
+    """The nuisances profiled per model and window (nuisance.window_tilt, apply_tilt,
     window_noise), on 7.5 s of coloured noise at 200 Hz: a waviness change dw = 0.4 applied
     as a PSD tilt is recovered within 0.05 (third-octave regression 1-12 Hz over 8 channels
     of independent noise; the slope's sd is about 0.02); white noise of sd 0.05 added to a
@@ -149,7 +149,7 @@ def test_per_model_nuisances_tilt_and_noise():
     import numpy as np
     from scipy import signal
 
-    from diagnosis.pipeline import apply_tilt, window_noise, window_tilt
+    from diagnosis.nuisance import apply_tilt, window_noise, window_tilt
 
     fs, n = 200.0, 1500
     rng = np.random.default_rng(3)
@@ -179,7 +179,8 @@ def test_prelevel_gives_linear_models_the_nominal_level_and_nonlinear_ones_their
 
     import numpy as np
 
-    from diagnosis.pipeline import Simulate, State, load_measured, prepare
+    from diagnosis.pipeline import load_measured, prepare
+    from diagnosis.truck_model import Simulate, State
     from diagnosis.signals import Signals
 
     drive, sig = load_measured(short_drive)
@@ -222,7 +223,8 @@ def test_nominal_levels_travel_to_the_workers(short_drive):
 
     import numpy as np
 
-    from diagnosis.pipeline import Simulate, load_measured, prepare
+    from diagnosis.pipeline import load_measured, prepare
+    from diagnosis.truck_model import Simulate
 
     drive, sig = load_measured(short_drive)
     ctx = prepare(sig, drive.vehicle, workers=1)
@@ -257,7 +259,8 @@ def test_a_candidate_at_its_neutral_value_is_the_nominal_model(short_drive):
     Exudyn."""
     import numpy as np
 
-    from diagnosis.pipeline import Simulate, State, load_measured, prepare
+    from diagnosis.pipeline import load_measured, prepare
+    from diagnosis.truck_model import Simulate, State
 
     drive, sig = load_measured(short_drive)
     ctx = prepare(sig, drive.vehicle, workers=1)

@@ -1,4 +1,4 @@
-"""The diagnosis's road fit leaves nmax to the data (issue 15 item 3, ``pipeline.fit_nmax``).
+"""The diagnosis's road fit leaves nmax to the data (issue 15 item 3, ``road_fit.fit_nmax``).
 
 The "measured" records are made by the diagnosis's own nominal model (``TruckModel``) on
 a one-segment road at 10 m/s with the measured noise floor added, so the test checks the
@@ -14,7 +14,7 @@ ACC_NOISE, DISP_NOISE = 0.03, 1.0e-4
 
 
 def _model(nmax=None):
-    from diagnosis.pipeline import TruckModel
+    from diagnosis.truck_model import TruckModel
 
     t = np.arange(int(DUR * FS)) / FS
     names = [f"{q}{i}{s}" for q in ("susp_disp_", "axle_acc_", "body_acc_")
@@ -34,7 +34,7 @@ def _measured(nmax, seed, effects=None):
 
 
 def _fit(sig, **kw):
-    from diagnosis import pipeline as P
+    from diagnosis import road_fit as P
 
     m = _model()
     diag = {}
@@ -51,7 +51,7 @@ def test_band_limited_road_gets_a_lower_nmax():
 
 @pytest.mark.parametrize("seed", [1, 2])
 def test_full_band_road_keeps_nmax_5(seed):
-    from diagnosis.pipeline import NMAX_EVIDENCE, ROAD_NMAX
+    from diagnosis.road_fit import NMAX_EVIDENCE, ROAD_NMAX
 
     nmax, diag = _fit(_measured(5.0, seed))
     assert nmax == ROAD_NMAX
@@ -61,7 +61,7 @@ def test_full_band_road_keeps_nmax_5(seed):
 def test_roll_off_is_not_taken_for_a_cut(monkeypatch):
     """Tyre enveloping 0.3 m (first zero at 3.3 cycles/m): the high-band share falls as a
     cut would make it fall, but above any cut the measurement keeps road power."""
-    from diagnosis import pipeline as P
+    from diagnosis import road_fit as P
 
     sig = _measured(5.0, 3, effects={"tyre_enveloping": {"length": 0.3}})
     nmax, diag = _fit(sig)
@@ -73,7 +73,7 @@ def test_roll_off_is_not_taken_for_a_cut(monkeypatch):
 
 def _fit_as_road_fit_does(sig):
     """A model whose band was fitted as ``fit_road`` fits it (inputs kept for the refit)."""
-    from diagnosis import pipeline as P
+    from diagnosis import road_fit as P
 
     m = _model()
     m.band_inputs = {"gq": m.gq.copy(), "noise": dict(m.noise)}
@@ -84,7 +84,7 @@ def _fit_as_road_fit_does(sig):
 def test_band_refit_without_an_effect_repeats_the_first_fit():
     """refit_band changes only the effects: with none it is the first fit again, bit for bit,
     and it leaves the model as it was."""
-    from diagnosis import pipeline as P
+    from diagnosis import road_fit as P
 
     sig = _measured(2.0, 4)
     m = _fit_as_road_fit_does(sig)
@@ -100,7 +100,7 @@ def test_band_refit_with_the_effect_in_the_truck_sees_the_cut():
     high-frequency power fills the measured 20-50 Hz share the cut emptied (what hid the cut
     on the independent truck's measured-profile drives, results/diagnosis_blind/
     20261129-twin-tracks/).  With the friction in the simulations too the cut is found."""
-    from diagnosis import pipeline as P
+    from diagnosis import road_fit as P
 
     fr = {"leaf_friction": {"force": 3000.0}}
     sig = _measured(2.0, 5, effects=fr)

@@ -1,4 +1,4 @@
-"""The diagnosis's per-piece re-levelling keeps a model's static state (diagnosis.pipeline.relevel).
+"""The diagnosis's per-piece re-levelling keeps a model's static state (diagnosis.nuisance.relevel).
 
 Reference (model-free): a road-level factor scales the response about the static state, not
 the static state itself. A suspension displacement made of a static offset plus a zero-mean
@@ -11,7 +11,7 @@ measurement does not have.
 import numpy as np
 import pytest
 
-from diagnosis.pipeline import relevel
+from diagnosis.nuisance import relevel
 
 
 def _skew(x):
@@ -58,7 +58,7 @@ def _motion(rng, n):
 
 
 class _OffsetModel:
-    """A stand-in for pipeline.TruckModel: its 'simulation' of a window is a static offset
+    """A stand-in for truck_model.TruckModel: its 'simulation' of a window is a static offset
     (a payload change) plus 8 mm rms of Gaussian motion; two road pieces of 5 s."""
 
     fs = 200.0
@@ -73,7 +73,7 @@ class _OffsetModel:
         return {"susp_disp_3L": self.offset + 0.008 * _motion(np.random.default_rng(seed), n)}
 
     def pieces(self, t0, t1):
-        from diagnosis.pipeline import TruckModel
+        from diagnosis.truck_model import TruckModel
         return TruckModel.pieces(self, t0, t1)
 
     def add_noise(self, chans, seed, noise=None):
@@ -81,12 +81,12 @@ class _OffsetModel:
 
 
 def test_the_simulate_callable_keeps_the_static_offset_through_the_re_levelling(monkeypatch):
-    """The wiring: ``pipeline.Simulate`` re-levels each road piece to the measured window by
+    """The wiring: ``truck_model.Simulate`` re-levels each road piece to the measured window by
     its own factor (measured 4 and 12 mm rms below 4 Hz against 8 mm simulated: factors of
     about 0.5 and 1.5) and must keep the offset in both pieces (the old ``x * g`` left about
     -11.5 and -34.5 mm: a 23 mm step between the pieces)."""
-    import diagnosis.pipeline as pl
-    from diagnosis.pipeline import Simulate, State
+    import diagnosis.truck_model as pl
+    from diagnosis.truck_model import Simulate, State
     from diagnosis.signals import Signals
 
     monkeypatch.setattr(pl, "TILT_REFIT", False)

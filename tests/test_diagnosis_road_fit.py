@@ -76,7 +76,8 @@ def test_joint_road_fit_recovers_w_with_an_effect_on(tmp_path, w):
     scatter between road seeds on a 24 s record."""
     import numpy as np
 
-    from diagnosis.pipeline import load_measured, prepare, window_tilt
+    from diagnosis.nuisance import window_tilt
+    from diagnosis.pipeline import load_measured, prepare
 
     drive, sig = load_measured(_drive(tmp_path, w, 0.1, 1))
     m = prepare(sig, drive.vehicle, workers=1).model
@@ -150,7 +151,7 @@ SENSOR_E = [[NAN, 7.42, 9.39, 8.82, 3.3, NAN], [NAN, 4.56, 6.06, 6.91, 1.04, NAN
 def _low(d):
     import numpy as np
 
-    from diagnosis.pipeline import NMAX_EVIDENCE, NMAX_GRID, ROAD_NMAX
+    from diagnosis.road_fit import NMAX_EVIDENCE, NMAX_GRID, ROAD_NMAX
 
     d = np.asarray(d, float)
     g0 = NMAX_GRID.index(ROAD_NMAX)
@@ -163,7 +164,7 @@ def test_a_roll_off_in_one_segment_leaves_every_segment_uncut():
     segment is cut (without the veto segment 5 is cut at 2 cycles/m, as it was)."""
     import numpy as np
 
-    from diagnosis.pipeline import ROAD_NMAX, choose_nmax
+    from diagnosis.road_fit import ROAD_NMAX, choose_nmax
 
     d, e = np.array(SENSOR_D), np.array(SENSOR_E)
     out, rolloff, vetoed = choose_nmax(d, e, _low(d))
@@ -179,7 +180,7 @@ def test_a_road_cut_in_every_segment_is_kept():
     too short, NaN), there is no roll-off, and the cuts stand."""
     import numpy as np
 
-    from diagnosis.pipeline import choose_nmax
+    from diagnosis.road_fit import choose_nmax
 
     d = np.full((6, 4), NAN)
     e = np.full((6, 4), NAN)
@@ -196,7 +197,7 @@ def test_a_low_segment_without_any_cut_statistic_is_no_roll_off():
     roll-off: it does not veto another segment's cut."""
     import numpy as np
 
-    from diagnosis.pipeline import choose_nmax
+    from diagnosis.road_fit import choose_nmax
 
     d = np.full((6, 2), NAN)
     e = np.full((6, 2), NAN)
