@@ -7,20 +7,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 
+from eroad.argtypes import finite_float
 from eroad.errors import EroadInputError
-
-
-def _finite(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
-    return v
 
 
 def register_import(dsub) -> None:
@@ -49,13 +39,13 @@ def register_import(dsub) -> None:
     p.add_argument("--out", metavar="DATASET", help="dataset folder to create (new or empty)")
     p.add_argument("--template", action="store_true",
                    help="print a commented template map and exit")
-    p.add_argument("--window", nargs=2, type=_finite, metavar=("T0", "T1"), default=None,
+    p.add_argument("--window", nargs=2, type=finite_float, metavar=("T0", "T1"), default=None,
                    help="keep T0 <= t <= T1 [s, the logger's time] (overrides the map)")
     p.add_argument("--vehicle", default=None,
                    help="built-in vehicle id or vehicle .toml (overrides the map)")
-    p.add_argument("--speed", type=_finite, default=None, metavar="MPS",
+    p.add_argument("--speed", type=finite_float, default=None, metavar="MPS",
                    help="constant speed [m/s] when the map has no speed column")
-    p.add_argument("--rate", type=_finite, default=None, metavar="HZ",
+    p.add_argument("--rate", type=finite_float, default=None, metavar="HZ",
                    help="output sample rate [Hz] (default: the map's, else the logger's)")
     p.add_argument("--split-gaps", action="store_true",
                    help="split at gaps into OUT/part01, part02, ... instead of refusing")

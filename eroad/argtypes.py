@@ -4,10 +4,11 @@ from __future__ import annotations
 import argparse
 import math
 
-__all__ = ["positive_float", "nonnegative_float", "nonnegative_int"]
+__all__ = ["finite_float", "positive_float", "nonnegative_float", "nonnegative_int"]
 
 
-def _finite(text: str) -> float:
+def finite_float(text: str) -> float:
+    """A finite number, else argparse's one-line error."""
     try:
         v = float(text)
     except ValueError:
@@ -19,7 +20,7 @@ def _finite(text: str) -> float:
 
 def positive_float(text: str) -> float:
     """A finite number > 0, else argparse's one-line error."""
-    v = _finite(text)
+    v = finite_float(text)
     if not v > 0:
         raise argparse.ArgumentTypeError(f"{text!r} must be positive")
     return v
@@ -27,7 +28,7 @@ def positive_float(text: str) -> float:
 
 def nonnegative_float(text: str) -> float:
     """A finite number >= 0, else argparse's one-line error."""
-    v = _finite(text)
+    v = finite_float(text)
     if v < 0:
         raise argparse.ArgumentTypeError(f"{text!r} must be >= 0")
     return v
