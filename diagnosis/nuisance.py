@@ -99,7 +99,7 @@ TILT_MAX = 1.0
 TILT_F_REF = 3.0
 
 
-def _band_log_ratios(f, pm, ps, nz, bands, f_unit, xs, ys) -> None:
+def band_log_ratios(f, pm, ps, nz, bands, f_unit, xs, ys) -> None:
     """Append ln(fc / f_unit) to ``xs`` and ln(measured band power less the white noise
     ``nz`` per bin / simulated band power) to ``ys`` for every band of ``bands`` (rows lo, fc,
     hi [Hz]) that holds a bin and where both powers are positive (``pm``, ``ps``: PSDs on
@@ -144,7 +144,7 @@ def window_tilt(meas: dict, sim: dict, fs: float, noise: dict) -> float:
     f, PM = welch(X, fs, L, hop=L - L // 2)
     _, PS = welch(Y, fs, L, hop=L - L // 2)
     for c, pm, ps in zip(names, PM, PS):
-        _band_log_ratios(f, pm, ps, 2.0 * noise.get(c, 0.0) ** 2 / fs, bands, 1.0, xs, ys)
+        band_log_ratios(f, pm, ps, 2.0 * noise.get(c, 0.0) ** 2 / fs, bands, 1.0, xs, ys)
     if len(set(np.round(xs, 6))) < 3:
         return 0.0
     return float(np.clip(-np.polyfit(xs, ys, 1)[0], -TILT_MAX, TILT_MAX))
@@ -164,7 +164,8 @@ def apply_tilt(sim: dict, fs: float, dw: float) -> dict:
     return out
 
 
-def _power(x):
+def channel_power(x):
+    """The variance of ``x`` (its power about its mean); NaN for fewer than two samples."""
     return float(np.var(x)) if x.size > 1 else float("nan")
 
 
@@ -227,9 +228,9 @@ def piece_levels(model: TruckModel, meas: dict, sim: dict, t0: float, t1: float,
     def factor(a, b):
         logs = []
         for c in model.channels:
-            pm = _power(meas[c][a:b]) - noise.get(c, 0.0) ** 2
-            pm = max(pm, 0.1 * _power(meas[c][a:b]))
-            ps = _power(sim[c][a:b])
+            pm = channel_power(meas[c][a:b]) - noise.get(c, 0.0) ** 2
+            pm = max(pm, 0.1 * channel_power(meas[c][a:b]))
+            ps = channel_power(sim[c][a:b])
             if ps > 0 and pm > 0:
                 logs.append(math.log(pm / ps))
         return math.exp(0.5 * float(np.mean(logs))) if logs else 1.0

@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from diagnosis.nuisance import W_FIT_BAND, W_FIT_QUANTITIES, _band_log_ratios, _power
+from diagnosis.nuisance import W_FIT_BAND, W_FIT_QUANTITIES, band_log_ratios, channel_power
 from diagnosis.signals import Signals
 from diagnosis.truck_model import ROAD_NMAX, ROAD_NMIN, ROAD_W, TruckModel
 from eroad.errors import EroadInputError
@@ -51,8 +51,8 @@ GQ_REF = 256e-6
 def segment_axle(names) -> int:
     """The axle whose suspension displacements segment the record (the reference axle of
     :class:`diagnosis.truck_model.TruckModel`): the inversion's (``inverse.run.reference_axle``:
-    axle 3 where logged, else the lowest-numbered axle logged on both sides), else, for a record with one side only,
-    the lowest-numbered axle with a displacement at all."""
+    axle 3 where logged, else the lowest-numbered axle logged on both sides), else, for a
+    record with one side only, the lowest-numbered axle with a displacement at all."""
     from inverse.run import PREFERRED_AXLE, reference_axle
 
     try:
@@ -113,8 +113,8 @@ def _level_logs(model, sig, sim: dict, mk) -> list:
     logs = []
     for c in model.channels:
         x = sig.channels[c][mk]
-        pm = max(_power(x) - model.noise.get(c, 0.0) ** 2, 0.1 * _power(x))
-        ps = _power(sim[c][mk])
+        pm = max(channel_power(x) - model.noise.get(c, 0.0) ** 2, 0.1 * channel_power(x))
+        ps = channel_power(sim[c][mk])
         if ps > 0 and pm > 0:
             logs.append(math.log(pm / ps))
     return logs
@@ -495,7 +495,7 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0, mapper
             for c in wchan:
                 f, pm, ps = _runs_psd(sig.channels[c], sim[c], runs, fs, 256)
                 nz = 2.0 * model.noise.get(c, 0.0) ** 2 / fs * sum(j - i for i, j in runs)
-                _band_log_ratios(f, pm, ps, nz, bands, v * 0.1, xs, ys)
+                band_log_ratios(f, pm, ps, nz, bands, v * 0.1, xs, ys)
             if len(set(np.round(xs, 6))) >= 3:
                 slope = float(np.polyfit(xs, ys, 1)[0])
                 w[k] = float(np.clip(ROAD_W - slope, *W_RANGE))
