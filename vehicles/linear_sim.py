@@ -114,6 +114,12 @@ def integrate(Phi, Gam, x0, F, every: int = 1) -> np.ndarray:
     return X
 
 
+#: step the unilateral tyres in the compiled loop of :mod:`vehicles.suspension_forces` (no
+#: element), not in :func:`integrate_unilateral`'s Python loop: the same states
+#: (tests/test_linear_sim.py), MEASURED faster
+COMPILED_UNILATERAL = True
+
+
 def integrate_unilateral(Phi, Gam, x0, F, Bu, rows, base, kc, cc, zr, zr_t, dt: float):
     """:func:`integrate` with unilateral tyres, every step: the tyre forces of the linear
     model corrected where a tyre would pull or is off the road, as
@@ -333,9 +339,18 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
         Bu = lm.Bk / kc[None, :]
         # the contact heights as Exudyn's correction reads them: the transpose of the road
         # input map (tyre_contact.unilateral_prestep)
-        X, off = integrate_unilateral(Phi, Gam, x0, F, Bu, np.ascontiguousarray(Bu.T),
-                                      own["f_static"] / kc, kc, cc, zr, zr_t, pl.dt)
-        X = X[np.arange(pl.n_out) * pl.n_sub]
+        uni = (Bu, np.ascontiguousarray(Bu.T), own["f_static"] / kc, kc, cc, zr, zr_t, pl.dt)
+        if COMPILED_UNILATERAL:
+            from vehicles import suspension_forces as sf
+
+            # the compiled loop of the local suspension forces, with no element: the same
+            # correction step by step (integrate_unilateral states it in NumPy)
+            X, off, _iters, _failed = sf.integrate(Phi, Gam, x0, F, pl.n_sub, pl.n_out,
+                                                   np.zeros((0, n)), np.zeros(0, np.int64),
+                                                   np.zeros((0, 3)), unilateral=uni)
+        else:
+            X, off = integrate_unilateral(Phi, Gam, x0, F, *uni)
+            X = X[np.arange(pl.n_out) * pl.n_sub]
     else:
         X = integrate(Phi, Gam, x0, F, every=pl.n_sub)
         if X.shape[0] < pl.n_out:        # a duration that is not a whole number of output periods
