@@ -135,8 +135,11 @@ FULL_GAP_Z = 2.0
 #: 2026-11-28 (``diagnosis.closed_loop.CLOSEST_SHARE_MIN``), now said by the verdict itself.
 #: Re-decided on the 931 saved blind diagnoses: 13 right names gained, 0 wrong (the nearest
 #: wrong: a damper asymmetry at 0.49 and a frame flexibility at 0.46 of the gap); on 56 fresh
-#: drives afterwards it changed no verdict, so it is not tested fresh (docs/diagnosis.md, "A
-#: vehicle effect taking most of the gap, named as a vehicle difference").  None: off.
+#: drives afterwards it changed no verdict; tested fresh at stop 62 on 60 drives of the
+#: independent truck with leaf friction (stated first): it fired on 2, both right names gained,
+#: 0 lost, 0 wrong (results/diagnosis_blind/20261130-vehicle-difference-powered/;
+#: docs/diagnosis.md, "A vehicle effect taking most of the gap, named as a vehicle
+#: difference").  None: off.
 VEHICLE_SHARE_MIN = 0.6
 #: the smallest deviation from "no effect" the verdict names, per effect: effect ->
 #: (parameter, neutral value, smallest relative deviation).  A winner calibrated closer to
