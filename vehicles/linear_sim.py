@@ -115,8 +115,12 @@ def integrate(Phi, Gam, x0, F, every: int = 1) -> np.ndarray:
 
 
 #: step the unilateral tyres in the compiled loop of :mod:`vehicles.suspension_forces` (no
-#: element), not in :func:`integrate_unilateral`'s Python loop: the same states
-#: (tests/test_linear_sim.py), MEASURED faster
+#: element), not in :func:`integrate_unilateral`'s Python loop: the same states to rounding
+#: (``test_compiled_lift_off_loop_is_the_numpy_statement``: 3e-14 of the sd).  Measured
+#: 2026-11-30 (results/pantograph_chassis/20261130-compiled-lift-off/): the chassis study's
+#: 63 drives 1.60x faster (their simulations 19.7 s against 31.5 s, the study 33.1 against
+#: 44.2 s, serial), every number of the study the same; one 30 s truck drive with lift-off
+#: 0.11 s against 0.29 s; the luliang diagnosis 26.0 against 28.7 s (little lift-off there)
 COMPILED_UNILATERAL = True
 
 
