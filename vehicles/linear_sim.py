@@ -120,7 +120,7 @@ def integrate(Phi, Gam, x0, F, every: int = 1) -> np.ndarray:
 #: 2026-11-30 (results/pantograph_chassis/20261130-compiled-lift-off/): the chassis study's
 #: 63 drives 1.60x faster (their simulations 19.7 s against 31.5 s, the study 33.1 against
 #: 44.2 s, serial), every number of the study the same; one 30 s truck drive with lift-off
-#: 0.11 s against 0.29 s; the luliang diagnosis 26.0 against 28.7 s (little lift-off there)
+#: 0.078 s against 0.147 s; the luliang diagnosis 26.0 against 28.7 s (little lift-off there)
 COMPILED_UNILATERAL = True
 
 
