@@ -320,17 +320,21 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
     cc = np.array([c.damping for c in model.contacts])
     off = 0
     elements, Cq = suspension_elements(own, pl.eff, ctx)
-    if elements:
+    uni = None
+    if unilateral:
+        Bu = lm.Bk / kc[None, :]
+        # the contact heights as Exudyn's correction reads them: the transpose of the road
+        # input map (tyre_contact.unilateral_prestep)
+        uni = (Bu, np.ascontiguousarray(Bu.T), own["f_static"] / kc, kc, cc, zr, zr_t, pl.dt)
+    if elements or (uni is not None and COMPILED_UNILATERAL):
+        # the compiled loop: the local suspension forces, and the lift-off correction before
+        # them (with no element, that correction alone: integrate_unilateral's rule)
         from vehicles import suspension_forces as sf
         from vehicles.simulate import _failure_message
 
         kinds, prm = sf.element_arrays(elements)
-        uni = None
-        if unilateral:
-            Bu = lm.Bk / kc[None, :]
-            uni = (Bu, np.ascontiguousarray(Bu.T), own["f_static"] / kc, kc, cc, zr, zr_t, pl.dt)
         X, off, _iters, failed = sf.integrate(Phi, Gam, x0, F, pl.n_sub, pl.n_out, Cq,
-                                                   kinds, prm, unilateral=uni)
+                                              kinds, prm, unilateral=uni)
         if failed >= 0 or X.shape[0] < pl.n_out:
             t_fail = (failed if failed >= 0 else X.shape[0] * pl.n_sub) * pl.dt
             exc = SimulationError(_failure_message(
@@ -339,22 +343,9 @@ def run(pl, road, y_offset: float, wall0: float, cpu0: float, unilateral: bool =
                 f"within {sf.MAX_ITER}"))
             exc.newton, exc.dt, exc.smaller_dt_may_help = True, pl.dt, True
             raise exc
-    elif unilateral:
-        Bu = lm.Bk / kc[None, :]
-        # the contact heights as Exudyn's correction reads them: the transpose of the road
-        # input map (tyre_contact.unilateral_prestep)
-        uni = (Bu, np.ascontiguousarray(Bu.T), own["f_static"] / kc, kc, cc, zr, zr_t, pl.dt)
-        if COMPILED_UNILATERAL:
-            from vehicles import suspension_forces as sf
-
-            # the compiled loop of the local suspension forces, with no element: the same
-            # correction step by step (integrate_unilateral states it in NumPy)
-            X, off, _iters, _failed = sf.integrate(Phi, Gam, x0, F, pl.n_sub, pl.n_out,
-                                                   np.zeros((0, n)), np.zeros(0, np.int64),
-                                                   np.zeros((0, 3)), unilateral=uni)
-        else:
-            X, off = integrate_unilateral(Phi, Gam, x0, F, *uni)
-            X = X[np.arange(pl.n_out) * pl.n_sub]
+    elif uni is not None:
+        X, off = integrate_unilateral(Phi, Gam, x0, F, *uni)
+        X = X[np.arange(pl.n_out) * pl.n_sub]
     else:
         X = integrate(Phi, Gam, x0, F, every=pl.n_sub)
         if X.shape[0] < pl.n_out:        # a duration that is not a whole number of output periods
