@@ -224,8 +224,9 @@ def simulate_tractor(vp, road, *, speed: float, duration: float, chassis: str = 
     solver : {"exudyn", "linear"}, optional
         Integrator (``vehicles.simulate.simulate``): Exudyn, or the linear model stepped with
         Exudyn's scheme (``vehicles.linear_sim``; the DCDC body and the flexible frame
-        included, tyre lift-off corrected), 3-5x faster per drive (0.32 -> 0.06 s for 10 s on a
-        class C road; 2.4 -> 0.6 s for 30 s on a road that lifts tyres).
+        included, tyre lift-off corrected), 4-6x faster per drive (measured 2026-11-30, second
+        of two runs at 10 m/s: 0.19 -> 0.034 s for 10 s on a class C road; 1.38 -> 0.35 s for
+        30 s on a class E road where the tyres are off in 40 % of the samples).
 
     Returns
     -------
