@@ -563,16 +563,33 @@ def _read_values(csv: Path, cols: list[str], probs: _Problems):
             continue
         q = QUANTITIES[parse_channel(c)[0]]
         if c in peak and peak[c][0] > q.limit:
+            hint = (_mapping_hint(c, values, first_bad, peak[c][0])
+                    or implausible_hint(parse_channel(c)[0], peak[c][0]))
             probs.add(csv, f"|value| up to {peak[c][0]:.4g} is implausible in {q.unit} "
-                      f"(limit {q.limit:g} {q.unit}): "
-                      f"{implausible_hint(parse_channel(c)[0], peak[c][0])}", column=c,
-                      row=peak[c][1])
+                      f"(limit {q.limit:g} {q.unit}): {hint}", column=c, row=peak[c][1])
             ok = False
     if neg_speed is not None:
         probs.add(csv, f"negative speed {neg_speed[0]:.4g} m/s; speed must be >= 0 m/s "
                   "(the vehicle drives forward)", column="speed", row=neg_speed[1])
         ok = False
     return values, ok, "time" not in first_bad
+
+
+def _mapping_hint(column: str, values: dict, first_bad: dict, peak: float) -> str | None:
+    """A suspension displacement over its range that physics says is not millimetres (a copy
+    of another column, swapped with an acceleration: ``drives.plausibility.
+    large_displacement_cause``); None where the unit hint stands.  Needs every column finite
+    and a usable time column."""
+    if not column.startswith("susp_disp_") or first_bad or "time" not in values:
+        return None
+    t = values["time"]
+    d = np.diff(t)
+    if t.size < 3 or not np.all(d > 0):
+        return None
+    from drives.plausibility import large_displacement_cause
+
+    return large_displacement_cause(column, values, 1.0 / float(np.median(d)),
+                                    named_only=peak < NOT_A_UNIT_BELOW.get("susp_disp", 0.0))
 
 
 def _check_time(csv: Path, t: np.ndarray, probs: _Problems) -> float | None:

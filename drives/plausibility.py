@@ -535,6 +535,93 @@ CLIP_SHARE = 0.002
 CLIP_MIN_SAMPLES = 5
 
 
+#: |correlation| above which a column is taken for a copy of another one [-]: the most alike
+#: distinct channels of the synthetic drives are the body accelerations above the two rear
+#: axles of the independent truck (0.988 on `second` seeds 3 and 4; our truck: the two axle
+#: ends of axle 2, -0.77), ten times further from 1
+COPY_CORRELATION = 0.999
+
+
+def _kinematic_si(susp, axle, body, fs: float, single_side: bool) -> tuple[bool, float, float]:
+    """Does the station obey s'' = a_axle - a_body in SI units (ratio within the check's
+    tolerance, correlation at least ``MIN_CORRELATION``)?  Returns (ok, ratio, corr)."""
+    ratio, corr = kinematic_ratio(susp, axle, body, fs)
+    tol = SI_LOG10_TOL if single_side else SI_LOG10_TOL_PAIR
+    ok = bool(np.isfinite(ratio) and ratio > 0 and corr >= MIN_CORRELATION
+              and abs(math.log10(ratio)) <= tol)
+    return ok, ratio, corr
+
+
+def large_displacement_cause(name: str, channels: dict, fs: float,
+                             named_only: bool = False) -> str | None:
+    """What a suspension-displacement column too large for metres holds, where physics says
+    more than "millimetres" (None: millimetres fits, or nothing can tell).
+
+    A column over its range is most often the right quantity in mm, and the range check says
+    so.  Two mistakes of a column map give the same symptom and a misleading hint: an
+    acceleration column mapped onto the displacement (or the two swapped), whose peaks of a
+    few m/s^2 read as millimetres.  Told apart by the kinematic identity s'' = a_axle - a_body
+    (:func:`kinematic_ratio`), which a displacement in mm obeys once divided by 1000 and an
+    acceleration does not:
+
+    * a copy of another column (|correlation| >= ``COPY_CORRELATION``);
+    * swapped with the station's axle or body acceleration (the identity holds in SI units
+      with the two columns exchanged);
+    * divided by 1000 the identity fails in shape (correlation below ``MIN_CORRELATION``)
+      or in scale: the millimetre hint stands, with that finding beside it (a station whose
+      sensors do not obey the identity, e.g. one very noisy, is not proof of another quantity).
+
+    Parameters
+    ----------
+    name : str
+        The displacement column, e.g. ``"susp_disp_3L"``.
+    channels : dict
+        Column name -> (N,) array of every channel of the file (finite values).
+    fs : float
+        Sample rate [Hz].
+    named_only : bool
+        Report only a copy or a swap (for values too small for millimetres, whose own hint,
+        a diverged simulation or a faulty sensor, stands otherwise).
+    """
+    p = parse_channel(name)
+    if p is None or p[0] != "susp_disp":
+        return None
+    x = np.asarray(channels[name], float)
+    if x.size < 3 or not np.all(np.isfinite(x)) or np.std(x) == 0.0:
+        return None
+    for other, y in channels.items():
+        y = np.asarray(y, float)
+        if other in (name, "time") or y.shape != x.shape or not np.all(np.isfinite(y)) \
+                or np.std(y) == 0.0:
+            continue
+        r = float(np.corrcoef(x, y)[0, 1])
+        if abs(r) >= COPY_CORRELATION:
+            return (f"not millimetres: the column repeats column '{other}' (correlation {r:.4f}); "
+                    f"a column mapped twice?")
+    st = f"{p[1]}{p[2]}"
+    axle, body = channels.get(f"axle_acc_{st}"), channels.get(f"body_acc_{st}")
+    if axle is None or x.size / fs < 4.0 / BAND_HZ[0] or fs < 2.5 * BAND_HZ[0]:
+        return None
+    axle = np.asarray(axle, float)
+    body = None if body is None else np.asarray(body, float)
+    ok, ratio, corr = _kinematic_si(x / 1000.0, axle, body, fs, True)
+    if ok:
+        return None
+    if _kinematic_si(axle, x, body, fs, True)[0]:
+        return (f"not millimetres: columns '{name}' and 'axle_acc_{st}' look swapped (the "
+                f"kinematic relation s'' = a_axle - a_body holds with the two exchanged)")
+    if body is not None and _kinematic_si(body, axle, x, fs, True)[0]:
+        return (f"not millimetres: columns '{name}' and 'body_acc_{st}' look swapped (the "
+                f"kinematic relation s'' = a_axle - a_body holds with the two exchanged)")
+    if named_only:
+        return None
+    pair = f"axle_acc_{st}" + ("" if body is None else f" - body_acc_{st}")
+    return (f"looks like millimetres, but divided by 1000 its second derivative does not match "
+            f"{pair} in {BAND_HZ[0]:g}-{BAND_HZ[1]:g} Hz (ratio {ratio:.3g}, correlation "
+            f"{corr:.2f}; about 1 and 1 for a displacement): check the column map before "
+            f"converting (an acceleration in this column?)")
+
+
 def check_signals(channels: dict) -> list[Finding]:
     """Channels that hold no measurement: constant over the record (a dead sensor, an
     unconnected logger input), or clipped (many samples at exactly the extreme value: the

@@ -327,3 +327,63 @@ def test_body_factor_rule_weighs_its_standard_error_and_the_noise_bias(monkeypat
     f = finding(-1.0, 0.05)
     assert not f.fatal and "sign is flipped" in f.message
     assert finding(-0.1, 0.05) is None                      # sign not determined
+
+
+def _with_columns(tmp_path, name, df, edit):
+    """A valid dataset of ``df``, then its channels.csv replaced by ``edit(df)`` (a logger's
+    file as it came: write_drive itself refuses such data)."""
+    path = write_drive(tmp_path / name, df, {"vehicle": "dump_truck_8x4", "speed_mps": 10.0})
+    edit(df.copy()).to_csv(path / "channels.csv", index=False, float_format="%.17g")
+    return path
+
+
+def _refusal(path) -> str:
+    with pytest.raises(EroadInputError) as e:
+        read_drive(path)
+    return str(e.value)
+
+
+@pytest.mark.parametrize("edit, expect", [
+    # the displacement in mm: the unit hint, unchanged
+    (lambda d: d.assign(susp_disp_1L=1000 * d["susp_disp_1L"]), "looks like millimetres"),
+    # swapped with the station's axle or body acceleration: named, both columns
+    (lambda d: d.rename(columns={"susp_disp_1L": "axle_acc_1L", "axle_acc_1L": "susp_disp_1L"}),
+     "columns 'susp_disp_1L' and 'axle_acc_1L' look swapped"),
+    (lambda d: d.rename(columns={"susp_disp_1L": "body_acc_1L", "body_acc_1L": "susp_disp_1L"}),
+     "columns 'susp_disp_1L' and 'body_acc_1L' look swapped"),
+    # one column mapped twice
+    (lambda d: d.assign(susp_disp_1L=d["axle_acc_3R"]), "repeats column 'axle_acc_3R'"),
+    # another station's acceleration, not a copy of a column of this file
+    (lambda d: d.assign(susp_disp_1L=d["axle_acc_3R"] + 0.5 * d["axle_acc_1R"]),
+     "check the column map"),
+])
+def test_a_displacement_column_too_large_for_metres_is_told_from_millimetres(tmp_path, edit, expect):
+    """The range check's hint for a suspension displacement over 0.5 m: millimetres only where
+    the column divided by 1000 obeys s'' = a_axle - a_body; a swap or a copy of an
+    acceleration column (peaks of m/s^2 that read as millimetres) is named instead.  Closed-form
+    station motions (no vehicle model); one line, and `eroad data check` exits 2.  Where the
+    column divided by 1000 fails the identity but nothing is named, the millimetre hint
+    stays with the finding beside it (a noisy station is no proof of another quantity)."""
+    path = _with_columns(tmp_path, "x", station_frame(seed=6), edit)
+    msg = _refusal(path)
+    assert "\n" not in msg and "column 'susp_disp_1L'" in msg and expect in msg, msg
+    if "swapped" in expect or "repeats" in expect:
+        assert "millimetres" in msg and "looks like millimetres" not in msg   # "not millimetres"
+    assert main(["data", "check", str(path)]) == 2
+
+
+def test_millimetres_on_both_truck_families_keep_the_unit_hint(truck_drive, tmp_path):
+    """Every displacement channel of our truck (Exudyn, null seed 11) and of the independently
+    written truck (second_measured seed 4) in mm: each still reads "looks like millimetres"
+    (one side alone passes the kinematic test in mm: the single-side tolerance, factor 3)."""
+    from drives.plausibility import large_displacement_cause
+    from drives.synth import synth_command
+
+    other = tmp_path / "second"
+    synth_command(scenario="second_measured", seed=4, duration=8.0, out=other)
+    for drive in (truck_drive, read_drive(other)):
+        ch = {c: drive.channels[c].to_numpy() for c in drive.channel_names}
+        mm = {k: (1000 * v if k.startswith("susp_disp") else v) for k, v in ch.items()}
+        for c in mm:
+            if c.startswith("susp_disp"):
+                assert large_displacement_cause(c, mm, drive.sample_rate_hz) is None, c
