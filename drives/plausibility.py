@@ -274,7 +274,12 @@ def check_units(channels: dict, fs: float) -> list[Finding]:
     duration = len(next(iter(channels.values()), ())) / fs if channels else 0.0
     if duration < 4.0 / BAND_HZ[0] or fs < 2.5 * BAND_HZ[0]:
         return out   # too short or too slowly sampled for the band check
+    swaps = swapped_columns(channels, fs)
+    out += swaps
+    swapped_axles = {str(parse_channel(f.column)[1]) for f in swaps}
     for st, (susp, axle, body) in _stations(channels).items():
+        if st.rstrip("LR") in swapped_axles:
+            continue   # said once, as the swap
         ratio, corr = kinematic_ratio(susp, axle, body, fs)
         if not np.isfinite(ratio):
             continue
@@ -301,6 +306,40 @@ def check_units(channels: dict, fs: float) -> list[Finding]:
             out.append(Finding(sname, f"{text}: {_which_in_g(best, susp, axle, body, fs)}", True))
         else:
             out.append(Finding(sname, f"{text}: a unit or scale error in one of them?", False))
+    return out
+
+
+def swapped_columns(channels: dict, fs: float) -> list[Finding]:
+    """Wheel stations whose suspension displacement and axle (or body) acceleration columns
+    are exchanged: the kinematic identity s'' = a_axle - a_body fails in SI units as labelled
+    and holds with the two columns exchanged (single-side tolerance).  A displacement in an
+    acceleration column stays inside every range check (centimetres read as m/s^2), so only
+    this tells.  One fatal finding per swapped pair, on the displacement column."""
+    out = []
+    for name in channels:
+        p = parse_channel(name)
+        if not p or p[0] != "susp_disp":
+            continue
+        st = f"{p[1]}{p[2]}"
+        axle, body = channels.get(f"axle_acc_{st}"), channels.get(f"body_acc_{st}")
+        if axle is None:
+            continue
+        x = np.asarray(channels[name], float)
+        axle = np.asarray(axle, float)
+        body = None if body is None else np.asarray(body, float)
+        if _kinematic_si(x, axle, body, fs, True)[0]:
+            continue
+        for other, args in ((f"axle_acc_{st}", (axle, x, body)),
+                            (f"body_acc_{st}", (body, axle, x) if body is not None else None)):
+            if args is None:
+                continue
+            ok, ratio, corr = _kinematic_si(*args, fs, True)
+            if ok:
+                out.append(Finding(name, f"columns '{name}' and '{other}' look swapped: the "
+                                   f"kinematic relation s'' = a_axle - a_body fails as labelled and "
+                                   f"holds with the two exchanged (ratio {ratio:.3g}, correlation "
+                                   f"{corr:.2f} in {BAND_HZ[0]:g}-{BAND_HZ[1]:g} Hz)", True))
+                break
     return out
 
 

@@ -387,3 +387,21 @@ def test_millimetres_on_both_truck_families_keep_the_unit_hint(truck_drive, tmp_
         for c in mm:
             if c.startswith("susp_disp"):
                 assert large_displacement_cause(c, mm, drive.sample_rate_hz) is None, c
+
+
+@pytest.mark.parametrize("other", ["axle_acc_3L", "body_acc_3L"])
+def test_a_displacement_swapped_with_an_acceleration_inside_every_range_is_refused(tmp_path, other):
+    """Displacements of centimetres in an acceleration column and accelerations below 0.5 m/s^2
+    in the displacement column pass every range check; the identity with the two columns
+    exchanged names the swap (fatal, one line, the pair named); the other axle says nothing."""
+    df = station_frame(seed=7)
+    k = 0.4 / max(df[c].abs().max() for c in df.columns if "acc" in c)   # a smooth road
+    df = df.assign(**{c: k * df[c] for c in df.columns if c != "time"})   # the identity is linear
+    path = _with_columns(tmp_path, "s", df,
+                         lambda d: d.rename(columns={"susp_disp_3L": other, other: "susp_disp_3L"}))
+    msg = _refusal(path)
+    assert "\n" not in msg and f"columns 'susp_disp_3L' and '{other}' look swapped" in msg, msg
+    ch = _channels(pd.read_csv(path / "channels.csv"))
+    found = check_units(ch, FS)
+    assert [f.column for f in found] == ["susp_disp_3L"] and found[0].fatal
+    assert check_units(_channels(df), FS) == []
