@@ -72,7 +72,7 @@ from .fdr import benjamini_hochberg, fcr_level
 from .signals import as_signals
 from .welch import cross_spectra, segment_ffts
 
-__all__ = ["Transmissibility", "transmissibility", "TwoInputResponse", "two_input_response",
+__all__ = ["Transmissibility", "transmissibility", "axle_body_pairs", "TwoInputResponse", "two_input_response",
            "TwoInputTransmissibility", "transmissibility_two_input", "two_input_stations",
            "FrontRear", "front_rear", "Shape",
            "distribution_shape", "sprague_geers", "russell", "gcc_delay"]
@@ -191,6 +191,20 @@ def _log_h1(x, y, fs, bands, Ls, min_coherence):
     return T, V, G
 
 
+def axle_body_pairs(measured, simulated) -> list[tuple[str, str]]:
+    """``(axle_acc_<pos>, body_acc_<pos>)`` for every wheel position whose two channels are
+    in both records (the pairs of :func:`transmissibility`)."""
+    meas, sim = as_signals(measured), as_signals(simulated)
+    pairs = []
+    for c in meas.channels:
+        qn, ax, side = _pos(c)
+        if qn == "axle_acc":
+            out = f"body_acc_{ax}{side}"
+            if out in meas.channels and c in sim.channels and out in sim.channels:
+                pairs.append((c, out))
+    return pairs
+
+
 def transmissibility(measured, simulated, *, pairs: Sequence[tuple[str, str]] | None = None,
                      bands: np.ndarray | None = None, q: float = 0.05, min_coherence: float = 0.3,
                      se_floor: float = 0.01, bins_per_band: int = 8,
@@ -219,15 +233,11 @@ def transmissibility(measured, simulated, *, pairs: Sequence[tuple[str, str]] | 
     """
     meas, sim = as_signals(measured), as_signals(simulated)
     if pairs is None:
-        pairs = []
-        for c in meas.channels:
-            qn, ax, side = _pos(c)
-            if qn == "axle_acc":
-                out = f"body_acc_{ax}{side}"
-                if out in meas.channels and c in sim.channels and out in sim.channels:
-                    pairs.append((c, out))
+        pairs = axle_body_pairs(meas, sim)
     if not pairs:
-        raise EroadInputError("transmissibility: no axle_acc/body_acc pair in both records")
+        raise EroadInputError("transmissibility: no wheel station with both an axle and a body "
+                              "acceleration (axle_acc_<axle><side>, body_acc_<axle><side>) in "
+                              "both records")
     bands = third_octave_bands() if bands is None else np.asarray(bands, dtype=float)
     res = {k: [] for k in ("Tm", "Vm", "Gm", "Ts", "Vs", "Gs")}
     for a, b in pairs:

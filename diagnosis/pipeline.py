@@ -480,6 +480,19 @@ def signature_null(model: TruckModel, sig: Signals, sim: Signals, records, seeds
     return out
 
 
+def transmissibility_or_none(measured, simulated):
+    """:func:`diagnosis.compare.transmissibility` of two records, or None where no wheel
+    station has both an axle and a body acceleration (a logger without body accelerometers):
+    the drive is diagnosed without the transmissibility signature, and the verdict names an
+    effect only where its rules for an unconfirmed signature allow
+    (:func:`diagnosis.verdict.decide_one`)."""
+    from diagnosis.compare import axle_body_pairs, transmissibility
+
+    if not axle_body_pairs(measured, simulated):
+        return None
+    return transmissibility(measured, simulated)
+
+
 def two_input_or_none(measured, simulated):
     """:func:`diagnosis.compare.transmissibility_two_input` of two records, or None where no
     station has both axle accelerations and a body acceleration (the signature then falls
@@ -519,6 +532,8 @@ def _model_signature(model: TruckModel, sig: Signals, sim: Signals, tr, tr2, ran
     t = _time.perf_counter()
     seeds = signature_seeds(seed)
     runs = _phase_runs(model, entry.effects, sig.time.size / sig.fs, seeds, executor)
+    if tr is None:     # no axle and body acceleration at one station: no transmissibility
+        return None, None, _time.perf_counter() - t, runs
     simw = Signals(sig.time, model.add_noise(runs[0], seeds[0]), dict(sig.units), sig.speed,
                    {"model": entry.effect})
     null = signature_null(model, sig, simw, runs[1:], seeds[1:])
@@ -720,7 +735,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         The summary written to ``out/summary.json``.
     """
     from diagnosis.band_edge import trial_cut
-    from diagnosis.compare import distribution_shape, transmissibility
+    from diagnosis.compare import distribution_shape
     from diagnosis.report import build_summary, write_report
     from diagnosis.verdict import SIGNATURE_METHOD, own_statistic, search_ranges
     from diagnosis.which import combine_folds, rank_effects, rank_effects_folds
@@ -763,7 +778,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                       {"model": "nominal"})
         loc = localize(sig, sim, segments=segs)
         wheelbase = float(vp.axles[0].x - vp.axles[2].x) if len(vp.axles) >= 3 else None
-        tr = transmissibility(sig, sim)
+        tr = transmissibility_or_none(sig, sim)
         tr2 = two_input_or_none(sig, sim)
         fr = front_rear_or_none(sig, sim, wheelbase=wheelbase)
         sh = distribution_shape(sig, sim)

@@ -573,6 +573,13 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                  "(a correct model can score several times 1 against itself on another road "
                  "phase: the range under \"What is left\"); the two-input ratio removes that.\n")
     T = summary.get("transmissibility")
+    if not T and summary.get("ranking"):
+        L.append("**Axle-to-body transmissibility**: not measured -- no wheel station of the "
+                 "record has both an axle and a body acceleration, so the road-independent "
+                 "signature the verdict checks a named effect against is missing; an effect is "
+                 "named only where it takes most of the gap (the rules for an unconfirmed "
+                 "signature), never 'clear'. Log a body accelerometer above an instrumented axle "
+                 "to have it.\n")
     if T:
         L.append("**Axle-to-body transmissibility** (ln|H_sim| - ln|H_meas|):\n")
         for a, b in T["pairs"]:

@@ -807,6 +807,9 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                          signature_share=signature_share, signature_null=signature_null,
                          corroborate=corroborate, own=own, null_sd=signature_null_sd)
     agrees, c0, c1, sig_max, own_res = st.agrees, st.c0, st.c1, st.sig_max, st.own
+    # no transmissibility at all (no wheel station logs both an axle and a body
+    # acceleration): test 3. cannot be made, which counts as not confirmed -- never as agreed
+    unchecked = bool(agrees is None and own_res is None and not summary.get("transmissibility"))
     what = _what(sig_method)
     out = dict(base, explained_share=_f(share), closest=win["effect"], edge=edges,
                signature_agrees=agrees, signature_max=_f(sig_max), residual=residual(summary, win),
@@ -838,6 +841,8 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                      f"at most {OWN_Z_MODEL:g} asked; it moves the statistic "
                      f"{own_res.get('moved', float('nan')):.0%} of the way from the nominal model's "
                      f"value to the measurement, at least {OWN_SHARE:.0%} asked)")
+    elif unchecked:
+        short.append(f"its road-independent signature cannot be checked: {NO_PAIR_TEXT}")
     elif agrees is False:
         short.append(f"its {what} still disagrees with the measurement "
                      f"(mean z^2 {c1:.2g}, nominal {c0:.2g}, at most {sig_max:.2g} asked"
@@ -860,10 +865,11 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     res = out["residual"]
     gap_z = ((res["heldout_gap"] - res["correct_model_gap"]) / res["correct_model_sd"]
              if res.get("correct_model_sd") else float("nan"))
-    on_gap_alone = (own_res is None and agrees is False and len(short) == 1 and gap_present
+    unconfirmed = agrees is False or unchecked
+    on_gap_alone = (own_res is None and unconfirmed and len(short) == 1 and gap_present
                     and rd.get("confidence") == "clear" and share >= FULL_SHARE_MIN
                     and gap_z <= FULL_GAP_Z)
-    as_vehicle = (not on_gap_alone and own_res is None and agrees is False and len(short) == 1
+    as_vehicle = (not on_gap_alone and own_res is None and unconfirmed and len(short) == 1
                   and gap_present and rd.get("confidence") == "clear" and vehicle_share is not None
                   and share >= vehicle_share and acts_on_vehicle(win["effect"]))
     if short and not (on_gap_alone or as_vehicle):
@@ -897,7 +903,12 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"there (mean z^2 {c0:.2g} -> {c1:.2g}) though it explains only {share:.0%} of the "
             f"held-out gap above a correct model's ({share_min:.0%} asked otherwise): a larger "
             f"difference no library effect lists remains beside it -- not 'clear'")
-    if on_gap_alone:
+    if on_gap_alone and unchecked:
+        caveats.append(
+            f"; named on the gap alone: with it the held-out gap ({res['heldout_gap']:.3g}) is "
+            f"a correct model's ({res['correct_model_gap']:.3g} +- {res['correct_model_sd']:.2g}), "
+            f"but its road-independent signature cannot be checked ({NO_PAIR_TEXT}) -- not 'clear'")
+    elif on_gap_alone:
         caveats.append(
             f"; named on the gap alone: with it the held-out gap ({res['heldout_gap']:.3g}) is "
             f"a correct model's ({res['correct_model_gap']:.3g} +- {res['correct_model_sd']:.2g}), "
@@ -905,7 +916,13 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"{sig_max:.2g} asked): the effect does not bring it nearer, so the "
             f"signature cannot confirm it, and what keeps the transmissibility off (a difference "
             f"beyond it, or this drive's noise) is not known -- not 'clear'")
-    if as_vehicle:
+    if as_vehicle and unchecked:
+        caveats.append(
+            f"; named as a vehicle difference: it changes the vehicle itself, explains most of the "
+            f"gap (at least {vehicle_share:.0%} asked) and no rival comes close, but its "
+            f"road-independent signature cannot be checked ({NO_PAIR_TEXT}): the nearest "
+            f"description of the vehicle the library has -- not 'clear'")
+    elif as_vehicle:
         caveats.append(
             f"; named as a vehicle difference: it changes the vehicle itself, explains most of the "
             f"gap (at least {vehicle_share:.0%} asked) and no rival comes close, but its "
@@ -953,6 +970,11 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                                 and not as_vehicle and not st.corroborated and dropped is None),
                 named_on=("gap_alone" if on_gap_alone else "vehicle_share" if as_vehicle
                           else "signature" if on_signature else None))
+
+
+#: why test 3. cannot be made on a drive without an axle and a body acceleration at one station
+NO_PAIR_TEXT = ("the dataset has no wheel station with both an axle and a body acceleration, "
+                "so the axle-to-body transmissibility is not measured")
 
 
 def acts_on_vehicle(effect: str) -> bool:

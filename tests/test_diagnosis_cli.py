@@ -311,3 +311,26 @@ def test_unknown_integrator_setting_refused_before_any_work(short_drive, tmp_pat
     with pytest.raises(EroadInputError, match="solver must be 'exudyn' or 'linear'"):
         diagnose(short_drive, tmp_path / "out", settings={"solver": "fast"}, workers=2)
     assert not (tmp_path / "out").exists()
+
+
+def test_a_drive_without_body_accelerometers_is_diagnosed_without_the_transmissibility(short_drive, tmp_path):
+    """A logger with no body accelerometer (the 16 s friction drive, every body_acc column
+    dropped): `eroad diagnose` runs to the end (it stopped with "transmissibility: no
+    axle_acc/body_acc pair in both records" before), writes no transmissibility and no
+    signature, says so in the report, and the verdict is never 'clear'."""
+    import pandas as pd
+
+    from drives.format import read_drive, write_drive
+
+    d = read_drive(short_drive)
+    frame = pd.DataFrame({"time": d.time, "speed": d.speed,
+                          **{c: d.channels[c] for c in d.channel_names if not c.startswith("body_acc")}})
+    ds = write_drive(tmp_path / "nobody", frame, dict(d.meta, vehicle=d.vehicle))
+    args = ["diagnose", "--quick", "--effects", "leaf_friction,sensor", "--workers", "1"]
+    assert main(args + [str(ds), "--out", str(tmp_path / "run")]) == 0
+    s = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert s["transmissibility"] is None and not s.get("signature")
+    assert s["verdict_confidence"] != "clear"
+    if s["verdict"] not in ("none", "unexplained"):
+        assert s["verdict_detail"]["named_on"] in ("gap_alone", "vehicle_share")
+    assert "not measured" in (tmp_path / "run" / "report.md").read_text()

@@ -412,3 +412,34 @@ def test_a_pooled_null_sd_gives_the_normal_prediction_bound():
     assert signature_threshold(rec, 2.0, 0.95, pooled_sd=POOLED_NULL_SD) == pytest.approx(want, rel=1e-6)
     assert signature_threshold({"chi2_correct_model": [0.5] * 4}, 2.0, 0.95, pooled_sd=0.33) == 2.0
     assert signature_threshold({}, 2.0, 0.95, pooled_sd=0.33) == 2.0
+
+
+def test_without_an_axle_and_body_acceleration_pair_the_signature_is_unconfirmed_never_agreed():
+    """A drive logged without body accelerometers has no transmissibility (``transmissibility``
+    None, no ``signature`` record): test 3. cannot be made, and that counts as not confirmed.
+    The rules that name an unconfirmed effect still apply -- the whole gap explained (on the gap
+    alone), a vehicle effect taking most of it (as a vehicle difference) -- 'ambiguous' at most
+    and never identified; anything else is 'unexplained', its reason saying what is missing."""
+    from diagnosis.verdict import VEHICLE_SHARE_MIN
+
+    def bare(**kw):
+        s = _summary(chi2=None, **kw)
+        s["transmissibility"] = None
+        return s
+
+    # 92 % of the gap, the gap left within a correct model's: named on the gap alone
+    d = decide(bare())
+    assert (d["verdict"], d["confidence"], d["identified"]) == ("leaf_friction", "ambiguous", False)
+    assert d["named_on"] == "gap_alone" and d["signature_agrees"] is None
+    assert "cannot be checked" in d["reason"] and "not 'clear'" in d["reason"]
+    # 65 %, the gap left 4 sd above: a vehicle effect is named as a vehicle difference ...
+    after = 1.0 - (VEHICLE_SHARE_MIN + 0.05) * 0.6
+    d = decide(bare(after=after))
+    assert (d["verdict"], d["confidence"], d["named_on"]) == ("leaf_friction", "ambiguous", "vehicle_share")
+    assert "cannot be checked" in d["reason"]
+    # ... an effect on the road input is not, nor is anything with the rule off
+    for d in (decide(_as_road_input_effect(bare(after=after))), decide(bare(after=after), vehicle_share=None)):
+        assert d["verdict"] == "unexplained" and "cannot be checked" in d["reason"]
+    # 50 %: unexplained
+    d = decide(bare(after=1.0 - 0.5 * 0.6))
+    assert d["verdict"] == "unexplained" and "no wheel station with both an axle and a body" in d["reason"]
