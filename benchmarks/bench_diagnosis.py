@@ -69,6 +69,10 @@ def main(argv=None) -> int:
     ap.add_argument("--family", choices=("nominal", "second"), default="nominal",
                     help="truth family: the Exudyn truck plus one effect (nominal), or the "
                          "independently written truck with out-of-library differences (second)")
+    ap.add_argument("--vehicle", default=None,
+                    help="truth and model vehicle of family nominal (built-in id or TOML; default "
+                         "the dump truck); payload strengths scaled by its nominal payload, the "
+                         "others the dump truck's (diagnosis.blind.make_cases)")
     ap.add_argument("--effects", default=None, metavar="A,B",
                     help="library effects the one-effect cases draw from, in turn (default: all the "
                          "family carries, diagnosis.blind.FAMILIES): a set aimed at some effects")
@@ -143,7 +147,7 @@ def main(argv=None) -> int:
                     settings=settings or None,
                     n_null=args.n if args.null_only else args.n_null, family=args.family,
                     effects=args.effects.split(",") if args.effects else None,
-                    progress=lambda m: print(m, flush=True))
+                    vehicle=args.vehicle, progress=lambda m: print(m, flush=True))
     wall = time.perf_counter() - t
     sc = out["score"]
     res = out["results"]

@@ -90,8 +90,21 @@ MEASURED_EVERY = 4
 NO_EFFECT_ANSWERS = ("none", "unexplained")
 
 
+#: the payload the blind strengths of ``payload`` were set for: the dump truck's [kg]; on another
+#: vehicle (``make_cases(vehicle=...)``) a drawn payload change is scaled by that vehicle's
+#: nominal payload over this, so it is the same share of what the vehicle carries
+STRENGTH_PAYLOAD_KG = 16000.0
+
+
+def nominal_payload(vehicle) -> float:
+    """The nominal payload [kg] of a vehicle (id or TOML path): its payload masses summed."""
+    from vehicles.params import load_vehicle
+
+    return float(sum(m.mass for m in load_vehicle(vehicle).sprung if m.payload))
+
+
 def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
-               family: str = "nominal") -> list[dict]:
+               family: str = "nominal", vehicle=None) -> list[dict]:
     """``n`` blind cases: effects in turn (strength drawn per case), every ``k``-th a null case.
 
     Parameters
@@ -109,6 +122,10 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
     family : {"nominal", "second"}
         Truth family (:data:`FAMILIES`); ``second`` case seeds are offset by 50000, and
         every :data:`MEASURED_EVERY`-th of its cases drives the measured road profile.
+    vehicle : str, optional
+        Truth and model vehicle (family ``nominal`` only; default the scenario's, the dump
+        truck): a payload change is scaled by its nominal payload (``STRENGTH_PAYLOAD_KG``);
+        every other strength is the dump truck's, whose weak ends were set on that truck.
 
     Returns
     -------
@@ -117,6 +134,10 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
     if family not in FAMILIES:
         raise ValueError(f"family must be one of {', '.join(FAMILIES)}, got {family!r}")
     scenario, fam_effects = FAMILIES[family]
+    if vehicle is not None and family != "nominal":
+        raise ValueError("a vehicle other than the scenario's is for the nominal family only "
+                         "(the independently written truck is the dump truck)")
+    payload_scale = 1.0 if vehicle is None else nominal_payload(vehicle) / STRENGTH_PAYLOAD_KG
     names = list(effects or fam_effects)
     bad = [e for e in names if e not in fam_effects]
     if bad:
@@ -130,6 +151,8 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
         ds_seed = 1000 * seed + 100 + i + off
         measured = family == "second" and i % MEASURED_EVERY == 0
         tag = dict(family=family, scenario="second_measured" if measured else scenario)
+        if vehicle is not None:
+            tag["vehicle"] = str(vehicle)
         if i in null_at:
             cases.append(dict(case=i, seed=ds_seed, effect="none", param=None, value=None, **tag))
             continue
@@ -141,6 +164,8 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
         v = math.exp(math.log(lo) + u * (math.log(hi) - math.log(lo))) if log else lo + u * (hi - lo)
         sign = (1.0 if rng.uniform() < 0.5 else -1.0) if signed else 1.0
         v = 1.0 + sign * v if name == "speed_scale" else sign * v
+        if name == "payload":
+            v *= payload_scale
         cases.append(dict(case=i, seed=ds_seed, effect=name, param=pname, value=float(v), **tag))
     return cases
 
@@ -184,7 +209,7 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
         for attempt in range(6):
             try:
                 synth_command(scenario=case.get("scenario", "null"), seed=case["seed"],
-                              effects=eff_items, out=ds,
+                              effects=eff_items, out=ds, vehicle=case.get("vehicle"),
                               force=True, duration=duration)
                 break
             except EroadInputError as exc:
@@ -460,7 +485,8 @@ def format_confusion(sc: dict) -> str:
 
 
 def run_blind(root, n: int = 30, *, seed: int = 0, workers: int = 2, duration=None, settings=None,
-              n_null: int | None = None, family: str = "nominal", effects=None, progress=print) -> dict:
+              n_null: int | None = None, family: str = "nominal", effects=None, vehicle=None,
+              progress=print) -> dict:
     """Run ``n`` blind cases under ``root``; write ``root/blind.json`` and ``root/confusion.txt``.
     ``effects``: the library effects the one-effect cases draw from (:func:`make_cases`).
 
@@ -475,7 +501,7 @@ def run_blind(root, n: int = 30, *, seed: int = 0, workers: int = 2, duration=No
     results = []
     t0 = _time.perf_counter()
     # case ids are stable; a redrawn road changes a case's dataset seed (recorded in results)
-    for case in make_cases(n, seed, n_null=n_null, family=family, effects=effects):
+    for case in make_cases(n, seed, n_null=n_null, family=family, effects=effects, vehicle=vehicle):
         r = done.get(case["case"])
         if r is None or r.get("value") != case["value"]:
             r = run_case(case, root, workers=workers, settings=settings, duration=duration,
