@@ -419,8 +419,10 @@ def rescore(root: Path, data_root: Path) -> list:
         if "skipped" in old:
             continue
         summ = json.loads((root / f"run-{old['seed']}" / "summary.json").read_text())
-        case = score_run(data_root / f"{old['scenario']}-{old['seed']}", old["scenario"], summ)
-        case.update(seed=old["seed"], scenario=old["scenario"], wall_s=old["wall_s"])
+        tag = f"{old['scenario']}-{old['vehicle']}" if old.get("vehicle") else old["scenario"]
+        case = score_run(data_root / f"{tag}-{old['seed']}", old["scenario"], summ)
+        case.update(seed=old["seed"], scenario=old["scenario"], wall_s=old["wall_s"],
+                    **({"vehicle": old["vehicle"]} if old.get("vehicle") else {}))
         cases.append(case)
     with (root / "results-rescored.jsonl").open("w") as f:
         for c in cases:
@@ -461,6 +463,10 @@ def main(argv=None) -> int:
     ap.add_argument("--measured-every", type=int, default=0, metavar="K",
                     help="with --scenario second: seeds S with (S - first seed) %% K == 0 drive the "
                          "measured profile (scenario second_measured); diagnosis/blind.py uses K = 4")
+    ap.add_argument("--vehicle", default=None,
+                    help="truth and model vehicle of scenarios random and null (built-in id or "
+                         "TOML; default the scenario's, the dump truck); its datasets are named "
+                         "SCENARIO-VEHICLE-SEED")
     ap.add_argument("--no-default-effects", action="store_true",
                     help="truth vehicle without the scenario's leaf friction (no model gap but the "
                          "flexible frame and the finer step): the method's accuracy alone")
@@ -486,6 +492,8 @@ def main(argv=None) -> int:
         ap.error("--measured-every needs --scenario second")
     if a.measured_every < 0:
         ap.error("--measured-every must be >= 0")
+    if a.vehicle and a.scenario not in ("random", "null"):
+        ap.error("--vehicle is for scenarios random and null (the independent truck is the dump truck)")
     from drives.synth import copy_without_truth, read_truth, synth_command
     from eroad.errors import EroadInputError
     from inverse.cli import run_inversion
@@ -509,10 +517,11 @@ def main(argv=None) -> int:
         scen = a.scenario
         if a.measured_every and (seed - a.first_seed) % a.measured_every == 0:
             scen = "second_measured"
-        ds = data_root / f"{scen}-{seed}"
+        tag = f"{scen}-{Path(a.vehicle).stem}" if a.vehicle else scen
+        ds = data_root / f"{tag}-{seed}"
         try:
             if not (ds / "truth" / "summary.json").is_file():
-                synth_command(scenario=scen, seed=seed, out=ds, force=True,
+                synth_command(scenario=scen, seed=seed, out=ds, force=True, vehicle=a.vehicle,
                               default_effects=not a.no_default_effects)
         except EroadInputError as exc:   # e.g. a class E road overloads a sensor range
             case = {"seed": seed, "scenario": scen, "skipped": str(exc)}
@@ -522,7 +531,7 @@ def main(argv=None) -> int:
             print(f"seed {seed}: skipped ({exc})", flush=True)
             seed += 1
             continue
-        blind = data_root / f"blind-{scen}-{seed}"
+        blind = data_root / f"blind-{tag}-{seed}"
         if not blind.exists():
             copy_without_truth(ds, blind)
         noise = None
@@ -544,7 +553,8 @@ def main(argv=None) -> int:
             summ = run_inversion(blind, root / f"run-{seed}", **inv)
         wall = time.perf_counter() - t0
         case = score_run(ds, scen, summ)
-        case.update(seed=seed, scenario=scen, wall_s=wall)
+        case.update(seed=seed, scenario=scen, wall_s=wall,
+                    **({"vehicle": Path(a.vehicle).stem} if a.vehicle else {}))
         with res_file.open("a") as f:
             f.write(json.dumps(case) + "\n")
         done[seed] = case
