@@ -72,6 +72,9 @@ def test_front_rear_delay_exposes_speed_scale_error():
     assert fr.pairs == [("axle_acc_1L", "axle_acc_3L")]
     assert fr.speed_scale[0] == pytest.approx(1.1, rel=0.01)
     assert fr.delay_ratio[0] == pytest.approx(1 / 1.1, rel=0.01)
+    # the ratio shown is that of the two whole-record delays shown beside it
+    assert fr.delay_ratio[0] == pytest.approx(fr.delay_meas[0] / fr.delay_sim[0], rel=1e-12)
+    assert fr.delay_ratio_lo[0] <= fr.delay_ratio[0] <= fr.delay_ratio_hi[0]
     assert fr.delay_significant[0]
     fr0 = front_rear(_drive(nom, 3), sim, wheelbase=4.0)
     assert not fr0.delay_significant[0]
