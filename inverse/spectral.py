@@ -100,8 +100,15 @@ class ParamBounds:
     Parameters
     ----------
     Gq_n0 : (float, float)
-        [m^3].  Default 1e-6 to 4.096e-3: from well below class A to the upper
-        bound of class F (the classes a truck drives at speed).
+        [m^3].  Default 1e-6 to 4.096e-3: from well below class A to class E's
+        MEAN (ISO 8608 as ``roadlib.psd.ISO_CLASSES``: E spans 2.048e-3 to
+        8.192e-3).  This line said "to the upper bound of class F" until 2026-11-30;
+        the bound never was.  A road in the upper half of class E is fitted on the
+        bound (reported "ON A BOUND"); its class stays E, its Gq(n0) reads low and
+        w compensates.  Raising the bound to F's top was tested and not adopted: it
+        brought ln Gq(n0) on such segments from 0.42 to 0.14 (median abs error) but
+        the freed fits report intervals too narrow for them and the stated bar failed
+        (results/inverse_blind/20261130-gq-upper-bound/).
     w : (float, float)
         [-].  Default 1.5 to 3.5, the range published measurements of real road
         profiles span (the previous 1.2-3.0 had no source, and a measured profile
