@@ -26,6 +26,7 @@ from inverse.segmentation import SegmentationResult, segment
 from inverse.sensitivity import FitConfig, FitResult, fit_segments
 from inverse.spectral import ParamBounds
 from inverse.validation import response_table
+from roadlib.psd import ISO_CLASSES
 
 #: spawn keys of the pipeline's random streams (see module docstring)
 SEED_KEY_FIT = (5, 1)
@@ -157,7 +158,9 @@ def at_bounds(Gq_n0: float, w: float, bounds) -> list:
         out.append(f"w = {bounds.w[side == 'upper']:g} ({side} bound)")
     lg = math.log(Gq_n0)
     if lg >= math.log(bounds.Gq_n0[1]) - AT_BOUND_TOL["ln_Gq_n0"]:
-        out.append(f"Gq_n0 = {bounds.Gq_n0[1]:g} m^3 (upper bound)")
+        out.append(f"Gq_n0 = {bounds.Gq_n0[1]:g} m^3 (upper bound"
+                   + (", class E's mean: a rougher road is fitted here, its level reads low"
+                      if bounds.Gq_n0[1] == ISO_CLASSES["E"].gd0 else "") + ")")
     elif lg <= math.log(bounds.Gq_n0[0]) + AT_BOUND_TOL["ln_Gq_n0"]:
         out.append(f"Gq_n0 = {bounds.Gq_n0[0]:g} m^3 (lower bound)")
     return out

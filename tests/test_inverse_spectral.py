@@ -58,6 +58,11 @@ def test_parameters_on_a_bound_are_named_and_reach_table1_note():
     pinned = at_bounds(100e-6, hw - 0.001, b)
     assert pinned == [f"w = {hw:g} (upper bound)"]
     assert at_bounds(b.Gq_n0[0], 2.0, b) == [f"Gq_n0 = {b.Gq_n0[0]:g} m^3 (lower bound)"]
+    # the upper bound is class E's mean (a class E road in its upper half reads low there): said
+    from roadlib.psd import ISO_CLASSES
+    assert b.Gq_n0[1] == ISO_CLASSES["E"].gd0
+    (top,) = at_bounds(b.Gq_n0[1], 2.0, b)
+    assert "upper bound, class E's mean" in top and "reads low" in top
     note = table1_note({"status": "clean"}, segments=[{"at_bound": []}, {"at_bound": pinned}])
     assert "On a bound" in note and "segment 2" in note and "segment 1" not in note
     assert "On a bound" not in table1_note({"status": "clean"}, segments=[{"at_bound": []}])
