@@ -329,18 +329,28 @@ def swapped_columns(channels: dict, fs: float) -> list[Finding]:
         body = None if body is None else np.asarray(body, float)
         if _kinematic_si(x, axle, body, fs, True)[0]:
             continue
-        for other, args in ((f"axle_acc_{st}", (axle, x, body)),
-                            (f"body_acc_{st}", (body, axle, x) if body is not None else None)):
-            if args is None:
-                continue
+        swap = _swap_partner(x, st, axle, body, fs)
+        if swap is not None:
+            other, ratio, corr = swap
+            out.append(Finding(name, f"columns '{name}' and '{other}' look swapped: the "
+                               f"kinematic relation s'' = a_axle - a_body fails as labelled and "
+                               f"holds with the two exchanged (ratio {ratio:.3g}, correlation "
+                               f"{corr:.2f} in {BAND_HZ[0]:g}-{BAND_HZ[1]:g} Hz)", True))
+    return out
+
+
+def _swap_partner(x, st: str, axle, body, fs: float) -> tuple[str, float, float] | None:
+    """The acceleration column of station ``st`` that the displacement column ``x`` was
+    swapped with -- the identity s'' = a_axle - a_body holds in SI units (single-side
+    tolerance) with the two exchanged, the axle's tried first -- as ``(column, ratio,
+    correlation)``; None where neither exchange makes it hold."""
+    for other, args in ((f"axle_acc_{st}", (axle, x, body)),
+                        (f"body_acc_{st}", None if body is None else (body, axle, x))):
+        if args is not None:
             ok, ratio, corr = _kinematic_si(*args, fs, True)
             if ok:
-                out.append(Finding(name, f"columns '{name}' and '{other}' look swapped: the "
-                                   f"kinematic relation s'' = a_axle - a_body fails as labelled and "
-                                   f"holds with the two exchanged (ratio {ratio:.3g}, correlation "
-                                   f"{corr:.2f} in {BAND_HZ[0]:g}-{BAND_HZ[1]:g} Hz)", True))
-                break
-    return out
+                return other, ratio, corr
+    return None
 
 
 def _stations(channels: dict) -> dict:
@@ -646,11 +656,9 @@ def large_displacement_cause(name: str, channels: dict, fs: float,
     ok, ratio, corr = _kinematic_si(x / 1000.0, axle, body, fs, True)
     if ok:
         return None
-    if _kinematic_si(axle, x, body, fs, True)[0]:
-        return (f"not millimetres: columns '{name}' and 'axle_acc_{st}' look swapped (the "
-                f"kinematic relation s'' = a_axle - a_body holds with the two exchanged)")
-    if body is not None and _kinematic_si(body, axle, x, fs, True)[0]:
-        return (f"not millimetres: columns '{name}' and 'body_acc_{st}' look swapped (the "
+    swap = _swap_partner(x, st, axle, body, fs)
+    if swap is not None:
+        return (f"not millimetres: columns '{name}' and '{swap[0]}' look swapped (the "
                 f"kinematic relation s'' = a_axle - a_body holds with the two exchanged)")
     if named_only:
         return None
