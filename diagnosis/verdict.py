@@ -903,32 +903,26 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"there (mean z^2 {c0:.2g} -> {c1:.2g}) though it explains only {share:.0%} of the "
             f"held-out gap above a correct model's ({share_min:.0%} asked otherwise): a larger "
             f"difference no library effect lists remains beside it -- not 'clear'")
-    if on_gap_alone and unchecked:
+    if on_gap_alone:
+        why = (f"its road-independent signature cannot be checked ({NO_PAIR_TEXT})" if unchecked else
+               f"its {what} stays off (mean z^2 {c1:.2g}, nominal {c0:.2g}, at most "
+               f"{sig_max:.2g} asked): the effect does not bring it nearer, so the "
+               f"signature cannot confirm it, and what keeps the transmissibility off (a difference "
+               f"beyond it, or this drive's noise) is not known")
         caveats.append(
             f"; named on the gap alone: with it the held-out gap ({res['heldout_gap']:.3g}) is "
             f"a correct model's ({res['correct_model_gap']:.3g} +- {res['correct_model_sd']:.2g}), "
-            f"but its road-independent signature cannot be checked ({NO_PAIR_TEXT}) -- not 'clear'")
-    elif on_gap_alone:
-        caveats.append(
-            f"; named on the gap alone: with it the held-out gap ({res['heldout_gap']:.3g}) is "
-            f"a correct model's ({res['correct_model_gap']:.3g} +- {res['correct_model_sd']:.2g}), "
-            f"but its {what} stays off (mean z^2 {c1:.2g}, nominal {c0:.2g}, at most "
-            f"{sig_max:.2g} asked): the effect does not bring it nearer, so the "
-            f"signature cannot confirm it, and what keeps the transmissibility off (a difference "
-            f"beyond it, or this drive's noise) is not known -- not 'clear'")
-    if as_vehicle and unchecked:
+            f"but {why} -- not 'clear'")
+    if as_vehicle:
+        why = (f"road-independent signature cannot be checked ({NO_PAIR_TEXT}): the nearest "
+               f"description of the vehicle the library has" if unchecked else
+               f"{what} does not confirm it (mean z^2 {c1:.2g}, nominal {c0:.2g}, at most "
+               f"{sig_max:.2g} asked): the nearest description of the vehicle the library has, and "
+               f"something beyond it may remain")
         caveats.append(
             f"; named as a vehicle difference: it changes the vehicle itself, explains most of the "
-            f"gap (at least {vehicle_share:.0%} asked) and no rival comes close, but its "
-            f"road-independent signature cannot be checked ({NO_PAIR_TEXT}): the nearest "
-            f"description of the vehicle the library has -- not 'clear'")
-    elif as_vehicle:
-        caveats.append(
-            f"; named as a vehicle difference: it changes the vehicle itself, explains most of the "
-            f"gap (at least {vehicle_share:.0%} asked) and no rival comes close, but its "
-            f"{what} does not confirm it (mean z^2 {c1:.2g}, nominal {c0:.2g}, at most "
-            f"{sig_max:.2g} asked): the nearest description of the vehicle the library has, and "
-            f"something beyond it may remain -- not 'clear'")
+            f"gap (at least {vehicle_share:.0%} asked) and no rival comes close, but its {why} "
+            f"-- not 'clear'")
     if st.corroborated:
         s2 = summary["signature_two_input"]
         caveats.append(
