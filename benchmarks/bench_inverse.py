@@ -409,6 +409,17 @@ def score_run(ds: Path, scen: str, summ: dict) -> dict:
     return case
 
 
+def vehicle_tag(vehicle) -> str:
+    """How a dataset name and a record name a vehicle: a built-in id, or a TOML file's stem."""
+    return Path(vehicle).stem
+
+
+def dataset_tag(scenario: str, vehicle=None) -> str:
+    """The dataset folder's name before its seed: the scenario, with the vehicle where one was
+    given (``--vehicle``), so that two vehicles' drives can share a data root."""
+    return f"{scenario}-{vehicle_tag(vehicle)}" if vehicle else scenario
+
+
 def rescore(root: Path, data_root: Path) -> list:
     """Score again every case of ROOT/results.jsonl from its saved ``run-SEED/summary.json``
     (e.g. after a change of the scoring); the new records go to ROOT/results-rescored.jsonl,
@@ -419,8 +430,8 @@ def rescore(root: Path, data_root: Path) -> list:
         if "skipped" in old:
             continue
         summ = json.loads((root / f"run-{old['seed']}" / "summary.json").read_text())
-        tag = f"{old['scenario']}-{old['vehicle']}" if old.get("vehicle") else old["scenario"]
-        case = score_run(data_root / f"{tag}-{old['seed']}", old["scenario"], summ)
+        case = score_run(data_root / f"{dataset_tag(old['scenario'], old.get('vehicle'))}-{old['seed']}",
+                         old["scenario"], summ)
         case.update(seed=old["seed"], scenario=old["scenario"], wall_s=old["wall_s"],
                     **({"vehicle": old["vehicle"]} if old.get("vehicle") else {}))
         cases.append(case)
@@ -517,7 +528,7 @@ def main(argv=None) -> int:
         scen = a.scenario
         if a.measured_every and (seed - a.first_seed) % a.measured_every == 0:
             scen = "second_measured"
-        tag = f"{scen}-{Path(a.vehicle).stem}" if a.vehicle else scen
+        tag = dataset_tag(scen, a.vehicle)
         ds = data_root / f"{tag}-{seed}"
         try:
             if not (ds / "truth" / "summary.json").is_file():
@@ -554,7 +565,7 @@ def main(argv=None) -> int:
         wall = time.perf_counter() - t0
         case = score_run(ds, scen, summ)
         case.update(seed=seed, scenario=scen, wall_s=wall,
-                    **({"vehicle": Path(a.vehicle).stem} if a.vehicle else {}))
+                    **({"vehicle": vehicle_tag(a.vehicle)} if a.vehicle else {}))
         with res_file.open("a") as f:
             f.write(json.dumps(case) + "\n")
         done[seed] = case
