@@ -97,10 +97,13 @@ STRENGTH_PAYLOAD_KG = 16000.0
 
 
 def nominal_payload(vehicle) -> float:
-    """The nominal payload [kg] of a vehicle (id or TOML path): its payload masses summed."""
+    """The nominal payload P [kg] of a vehicle (id or TOML path), as the payload effect knows
+    it: its range on that vehicle is [-P, +P] (``vehicles.effects.payload``, -P the empty
+    vehicle)."""
+    from vehicles.effects import get_effect
     from vehicles.params import load_vehicle
 
-    return float(sum(m.mass for m in load_vehicle(vehicle).sprung if m.payload))
+    return -float(get_effect("payload").vehicle_ranges(load_vehicle(vehicle))["mass"][0])
 
 
 def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
