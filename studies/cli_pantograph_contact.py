@@ -181,6 +181,13 @@ def _run(args: argparse.Namespace) -> int:
     if "contact" in s:
         cfg = s["config"]
         print(f"pantograph: {cfg['pantograph']}, frame friction {cfg['frame_friction_N']:g} N")
+        win = cfg.get("statistics_window_s")
+        if win:
+            asked = cfg.get("duration_requested_s")
+            short = (f" (asked {asked:g} s: the road is shorter)"
+                     if asked is not None and asked > cfg["duration_s"] else "")
+            print(f"drive {cfg['duration_s']:g} s{short}; statistics over t = {win[0]:g}-{win[1]:g} s "
+                  f"({win[1] - win[0]:g} s: the vehicle's run-in and the contact's settling left out)")
         print(f"contact force (drive):      {_fmt(s['contact'])}")
         if s.get("contact_base_at_rest"):
             print(f"contact force (base still): {_fmt(s['contact_base_at_rest'])}")

@@ -222,7 +222,12 @@ def contact_drive(road, *, speed_kmh: float = 80.0, duration: float = 30.0,
             "lateral": lat.as_dict(), "lateral_series": (tm, offset, yb),
             "wall": {"vehicle_s": wall_vehicle, "contact_s": wall_contact},
             "tractor": tractor_range(lift_pct, tyres),
-            "config": {"speed_kmh": float(speed_kmh), "duration_s": dur, "dt_s": dt,
+            "config": {"speed_kmh": float(speed_kmh), "duration_s": dur,
+                       "duration_requested_s": float(duration),
+                       # the statistics' interval in the drive's time: the vehicle's run-in
+                       # (t_skip) and the contact's own settling (t_range[0]) left out
+                       "statistics_window_s": [t_skip + t_range[0], t_skip + t_range[1]],
+                       "dt_s": dt,
                        "line": str(line), "pantograph": str(pp.name),
                        "frame_friction_N": pp.frame_friction,
                        "n_spans": cl.params.n_spans, "n_dof": int(res.meta["n_dof"]),

@@ -168,7 +168,15 @@ def test_rough_road_drive_lifts_off_with_unilateral_tyres(tmp_path):
     road = tmp_path / "road.npz"
     assert main(["road", "generate", "--class", "E", "--length", "120", "--width", "4", "--seed", "2",
                  "--out", str(road)]) == 0
-    out = contact_drive(RoadSurface.load(road), speed_kmh=80.0, duration=4.0, compare_static=False)
+    # 30 s asked on a 120 m road: the drive is shortened to the whole seconds the road covers
+    # (4 s), and says so; the statistics leave out the vehicle's run-in (1 s) and the
+    # contact's settling (1 s), and their window is the samples they used
+    out = contact_drive(RoadSurface.load(road), speed_kmh=80.0, duration=30.0, compare_static=False)
+    cfg = out["config"]
+    assert cfg["duration_requested_s"] == 30.0 and cfg["duration_s"] == 4.0
+    w0, w1 = cfg["statistics_window_s"]
+    assert w0 == 2.0 and w1 == pytest.approx(4.0, abs=0.01)
+    assert out["stats"]["n_samples"] == pytest.approx((w1 - w0) / cfg["dt_s"] + 1, abs=1)
     tr = out["tractor"]
     assert tr["tyres"] == "unilateral"
     assert tr["tyre_lift_off_percent"] > 5.0 and tr["within_model_range"] is True
