@@ -1,6 +1,6 @@
 """``eroad runs list|show``: the run archive (:mod:`eroad.archive`) on the command line.
 
-``eroad runs list [--root results] [--study NAME] [--json]`` prints a table of
+``eroad runs list [ROOT | --root results] [--study NAME] [--json]`` prints a table of
 every run folder under the root (study, run-id, status, start, wall time);
 ``eroad runs show RUN [--root results] [--json]`` prints the essentials of one
 run's ``run.json`` and ``summary.json``.  RUN is a run folder, a run-id or a
@@ -13,6 +13,7 @@ import json
 from typing import Any
 
 from eroad.archive import NOT_RECORDED, RunRecord, find_run, list_runs
+from eroad.errors import EroadInputError
 
 __all__ = ["register"]
 
@@ -33,7 +34,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     p_list = actions.add_parser("list", help="table of archived runs",
                                 description="Table of archived runs, oldest first.")
-    p_list.add_argument("--root", default="results",
+    p_list.add_argument("root_pos", nargs="?", metavar="ROOT", default=None,
+                        help="results root folder (same as --root)")
+    p_list.add_argument("--root", default=None,
                         help="results root folder (default: results)")
     p_list.add_argument("--study", default=None, help="only runs of this study")
     p_list.add_argument("--json", action="store_true",
@@ -73,12 +76,17 @@ def _row(rec: RunRecord) -> dict[str, Any]:
 
 
 def _cmd_list(args: argparse.Namespace) -> int:
+    if args.root_pos is not None and args.root is not None and args.root_pos != args.root:
+        raise EroadInputError(f"two results roots given: {args.root_pos} and --root {args.root}")
+    args.root = args.root_pos or args.root or "results"
     records = list_runs(args.root, study=args.study)
     if args.json:
         print(json.dumps([_row(r) for r in records], indent=2))
         return 0
     if not records:
-        print(f"no runs under {args.root}")
+        from pathlib import Path
+        missing = "" if Path(args.root).is_dir() else " (no such folder)"
+        print(f"no runs under {args.root}{missing}")
         return 0
     header = ("STUDY", "RUN-ID", "STATUS", "START (UTC)", "WALL")
     rows = [(r.study, r.run_id, r.status, r.start[:19].replace("T", " ") or "-",

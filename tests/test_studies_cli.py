@@ -30,6 +30,15 @@ def test_runs_list_table_and_json(tmp_path, capsys):
     assert [r["run_id"] for r in rows] == [bad.run_id]
     assert main(["runs", "list", "--root", str(tmp_path / "none")]) == 0
     assert "no runs" in capsys.readouterr().out
+    # the root may also be given as the positional argument a user tries first; two
+    # different roots are refused in one line; a root that does not exist is said to
+    assert main(["runs", "list", str(tmp_path), "--study", "fig11", "--json"]) == 0
+    assert [r["run_id"] for r in json.loads(capsys.readouterr().out)] == [bad.run_id]
+    assert main(["runs", "list", str(tmp_path / "none")]) == 0
+    assert capsys.readouterr().out.strip().endswith("(no such folder)")
+    assert main(["runs", "list", str(tmp_path), "--root", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "two results roots given" in err
 
 
 def test_runs_show(tmp_path, capsys):
