@@ -804,7 +804,7 @@ def configured_build(vp, chassis: str = "rigid", frame_segments: int | None = No
         ``effects`` are the resolved effect parameters.
     """
     from vehicles.builder import build_model
-    from vehicles.effects import EFFECTS, resolve_effects
+    from vehicles.effects import EFFECTS, resolve_effects, suspension_terms_of
     from vehicles.effects.base import Effect, EffectContext
     from vehicles.params import load_vehicle
 
@@ -820,13 +820,7 @@ def configured_build(vp, chassis: str = "rigid", frame_segments: int | None = No
             notes.append(f"effect {name}: its road/output hook is not part of the linear model")
         if EFFECTS[name].nonlinear:
             notes.append(f"effect {name}: nonlinear, linearised at rest (static equilibrium)")
-    terms_of = None
-    if any(type(EFFECTS[n]).suspension_terms is not Effect.suspension_terms for n in eff):
-        def terms_of(susp):
-            out = []
-            for n, p in eff.items():
-                out += list(EFFECTS[n].suspension_terms(susp, p, ctx) or [])
-            return out
+    terms_of = suspension_terms_of(eff, ctx)
     model = build_model(ctx.vp, chassis=ctx.chassis, frame_segments=ctx.frame_segments,
                         stiffness_factor=ctx.stiffness_factor, node_type="Rxyz",
                         suspension_terms=terms_of)

@@ -36,8 +36,8 @@ import numpy as np
 
 from eroad.errors import EroadInputError, SimulationError
 from vehicles.builder import SIDE_SIGN, SIDES, _quiet, build_model
-from vehicles.effects import EFFECTS, any_nonlinear, resolve_effects
-from vehicles.effects.base import Effect, EffectContext
+from vehicles.effects import EFFECTS, any_nonlinear, resolve_effects, suspension_terms_of
+from vehicles.effects.base import EffectContext
 from vehicles.params import VehicleParams, load_vehicle
 from vehicles.result import SimResult, unit_of
 from vehicles.tyre_contact import TYRE_CONTACTS, tyre_forces, unilateral_prestep
@@ -561,19 +561,13 @@ def _simulate_once(vehicle, road, speed, duration, chassis, effects, dt, fs_out,
     import exudyn as exu
     pl = _plan_drive(vehicle, road, speed, duration, chassis, effects, dt, fs_out, x_start, seed,
                      frame_segments)
-    vp0, vp, ctx, eff, profile, road_used = pl.vp0, pl.vp, pl.ctx, pl.eff, pl.profile, pl.road_used
-    dt, t_out, n_sub, n_steps, n_out = pl.dt, pl.t_out, pl.n_sub, pl.n_steps, pl.n_out
+    vp, ctx, eff, profile, road_used = pl.vp, pl.ctx, pl.eff, pl.profile, pl.road_used
+    dt, t_out, n_steps, n_out = pl.dt, pl.t_out, pl.n_steps, pl.n_out
     t_steps, s_steps, x_start, seed = pl.t_steps, pl.s_steps, pl.x_start, pl.seed
     duration, fs_out = pl.duration, pl.fs_out
 
     # ---- model
-    terms_of = None
-    if any(type(EFFECTS[n]).suspension_terms is not Effect.suspension_terms for n in eff):
-        def terms_of(susp):
-            out = []
-            for n, p in eff.items():
-                out += list(EFFECTS[n].suspension_terms(susp, p, ctx) or [])
-            return out
+    terms_of = suspension_terms_of(eff, ctx)
     model = build_model(vp, chassis=ctx.chassis, frame_segments=ctx.frame_segments,
                         stiffness_factor=ctx.stiffness_factor, suspension_terms=terms_of)
     built.append(model)

@@ -46,6 +46,21 @@ def any_nonlinear(effects) -> bool:
     return any(EFFECTS[n].nonlinear for n in effects or () if n in EFFECTS)
 
 
+def suspension_terms_of(effects: dict, ctx):
+    """The ``suspension_terms`` hook of :func:`vehicles.builder.build_model` for the resolved
+    ``effects`` ({name: params}): a function of one suspension that collects every effect's
+    extra terms there, or None where no effect adds any (the builder's plain suspension)."""
+    if not any(type(EFFECTS[n]).suspension_terms is not Effect.suspension_terms for n in effects):
+        return None
+
+    def terms_of(susp):
+        out = []
+        for n, p in effects.items():
+            out += list(EFFECTS[n].suspension_terms(susp, p, ctx) or [])
+        return out
+    return terms_of
+
+
 def get_effect(name: str) -> Effect:
     """The effect called ``name`` (EroadInputError naming the known ones otherwise)."""
     try:
@@ -117,4 +132,4 @@ def resolve_effects(effects) -> dict:
 
 
 __all__ = ["EFFECTS", "Effect", "EffectContext", "Parameter", "get_effect", "parse_effects",
-           "resolve_effects"]
+           "resolve_effects", "suspension_terms_of"]
