@@ -248,3 +248,66 @@ def identify_class(z, dx: float, band=None) -> str:
     ISO 8608 defines the classes for w = 2, so the level is fitted with w fixed.
     """
     return fit_iso_psd(profile_psd(z, dx), band=band, w=2.0).iso_class
+
+
+#: how far [decades] a road's PSD must fall below its own power law to count as ending there
+#: (:func:`content_top`): a generated road's band edge drops 4-10 decades within one Welch bin;
+#: a random road's bins scatter about the power law by a chi-square of tens of degrees of freedom
+#: (0.1-0.2 decades sd), so 2 decades is never reached by chance where the road has content
+CONTENT_DROP_DECADES = 2.0
+
+
+def content_top(psd: PsdEstimate, drop_decades: float = CONTENT_DROP_DECADES) -> float:
+    """Highest spatial frequency [cycles/m] up to which a road carries content: the last Welch
+    bin before the PSD falls ``drop_decades`` below the power law of the octave beneath it,
+    else the grid's Nyquist frequency 1/(2 dx).
+
+    Why: a road synthesised over ISO 8608's band ends at nmax (2.83 cycles/m by default), and a
+    grid of step dx holds nothing above 1/(2 dx); a vehicle driven over it at v m/s gets no road
+    input above ``content_top * v`` Hz, so what its spectra show there is not a response to the
+    road.  Local, so that a road of two slopes or one whose level changes along it is read
+    right: at each bin a straight line in log-log is fitted (least squares) to the octave below
+    it, and the edge is where the median of the next five bins lies ``drop_decades`` below that
+    line's extrapolation.
+
+    Parameters
+    ----------
+    psd : PsdEstimate
+        Welch estimate of a profile or of several tracks (:func:`profile_psd`).
+    drop_decades : float
+        Fall below the local power law that marks the end [decades] (default
+        :data:`CONTENT_DROP_DECADES`).
+
+    Returns
+    -------
+    float
+        [cycles/m], at most the Nyquist frequency of the estimate's grid.
+    """
+    n, G = np.asarray(psd.n, float), np.asarray(psd.G, float)
+    nyq = 0.5 / psd.dx
+    ok = n > 0
+    n, G = n[ok], G[ok]
+    ln, lg = np.log10(n), np.log10(np.maximum(G, 1e-300))
+    drop = float(drop_decades)
+    for i in range(n.size - 1):
+        oct_ = (n >= 0.5 * n[i]) & (n < n[i])
+        if oct_.sum() < 4:
+            continue
+        slope, icpt = np.polyfit(ln[oct_], lg[oct_], 1)
+        ahead = slice(i, min(i + 5, n.size))
+        if np.median(lg[ahead] - (icpt + slope * ln[ahead])) < -drop:
+            j = i
+            while lg[j] - (icpt + slope * ln[j]) >= -drop and j < n.size - 1:
+                j += 1
+            return float(n[max(j - 1, 0)])
+    return float(nyq)
+
+
+def surface_content_top(road, n_tracks: int = 5) -> float:
+    """:func:`content_top` of a road surface [cycles/m]: the Welch PSD averaged over up to
+    ``n_tracks`` grid lines spread evenly across the road (grid lines, so that no interpolation
+    between lines removes short waves), or its one track."""
+    y = np.asarray(road.y, float)
+    cols = np.unique(np.linspace(0, y.size - 1, min(int(n_tracks), y.size)).round().astype(int))
+    z = np.asarray(road.z, float)[:, cols]
+    return content_top(profile_psd(z, float(road.dx)))

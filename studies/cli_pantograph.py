@@ -126,8 +126,12 @@ def _cmd_pantograph(args: argparse.Namespace) -> int:
           f"error {chk['exact_max_rel_error']:.2g}; paper's linear method: "
           + ", ".join(f"{k} {v:.2g}" for k, v in chk["linear_max_rel_error"].items()))
     print("paper's findings for our model:")
+    beyond = set(summary.get("findings_beyond_road_input") or [])
     for k, holds in summary["findings"].items():
-        print(f"  ({k}) {'TRUE ' if holds else 'false'}  {summary['findings_claims'][k]}")
+        print(f"  ({k}) {'TRUE ' if holds else 'false'}  {summary['findings_claims'][k]}"
+              + ("  [band beyond the road's input]" if k in beyond else ""))
+    if summary.get("road_input_note"):
+        print(f"road input: {summary['road_input_note']}")
     print(f"details: {summary['path']}/data/findings.md; figure: "
           f"{summary['path']}/{summary['figures'][0]}")
     return 0

@@ -716,6 +716,7 @@ def compute_figure11(road, *, vehicle: Any = DEFAULT_VEHICLE, speed: float = 10.
             "road": {k: v for k, v in (road.meta or {}).items()
                      if isinstance(v, (int, float, str, bool))},
             "road_length_m": float(road.length)}
+    meta.update(road_input_band(road, speed))
     return Figure11Data(time=m.time, motion={c: getattr(m, c) for c in COMPONENTS},
                         fs=d["fs"], f=f, spectra=spectra, modes=modes, contributions=contrib,
                         check=d["check"], meta=meta)
@@ -883,6 +884,10 @@ def plot_figure11(data: Figure11Data | str | Path, path: str | Path, *, f_max: f
                 ax.set_xlabel("frequency [Hz]")
     axes[0, 0].set_xlim(0, f_max)
     meta = data.meta or {}
+    f_top = meta.get("road_input_top_hz")
+    if f_top is not None and float(f_top) < f_max:
+        for ax in axes.flat:
+            ax.axvspan(float(f_top), f_max, color="0.5", alpha=0.15, lw=0, hatch="//")
     from matplotlib.patches import Patch
     from matplotlib.lines import Line2D
 
@@ -892,7 +897,10 @@ def plot_figure11(data: Figure11Data | str | Path, path: str | Path, *, f_max: f
                Patch(color="tab:orange", alpha=0.3, label="6-10 Hz (findings b, d)"),
                Patch(color="tab:green", alpha=0.2, label="15-35 Hz (finding c)"),
                Line2D([], [], color="0.4", lw=0.6, ls=":", label="modes (below)")]
-    fig.legend(handles=handles, loc="lower center", ncol=5, fontsize=8, frameon=False,
+    if f_top is not None and float(f_top) < f_max:
+        handles.append(Patch(facecolor="0.5", alpha=0.3, hatch="//",
+                             label=f"no road input (above {float(f_top):.1f} Hz)"))
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False,
                bbox_to_anchor=(0.5, 0.022))
     fig.text(0.5, 0.004, "modes: " + ", ".join(f"{m['label']} {m['freq_hz']:.1f} Hz"
                                                for m in marks),
@@ -946,6 +954,46 @@ SMOOTH_HZ = 1.0
 PEAK_PROMINENCE = 0.5
 #: upper frequency of the findings' analysis [Hz] (Figure 11's range, the study bands)
 F_MAX = 40.0
+#: the frequency band [Hz] each finding's claim is about (what the road must excite for the
+#: finding to be judged on a response to the road)
+FINDING_BANDS_HZ = {"a": (0.0, 0.5), "b": (6.0, 10.0), "c": (15.0, 35.0), "d": (6.0, 10.0),
+                    "e": (20.0, F_MAX)}
+
+
+def road_input_band(road, speed: float) -> dict:
+    """Where the road's input to the vehicle ends: ``road_content_top_cpm``, the highest
+    spatial frequency the road file carries (:func:`roadlib.metrics.surface_content_top`: its
+    synthesis band's nmax, or its grid's Nyquist frequency), and ``road_input_top_hz`` = that
+    times the speed.  Above it the spectra hold no response to the road (a road made with
+    ISO 8608's default band, nmax 2.83 cycles/m, ends at 28.3 Hz at 10 m/s)."""
+    from roadlib.metrics import surface_content_top
+
+    n_top = float(surface_content_top(road))
+    return {"road_content_top_cpm": n_top, "road_input_top_hz": n_top * float(speed)}
+
+
+def findings_beyond_input(meta: Mapping | None) -> list[str]:
+    """The findings whose claimed band (:data:`FINDING_BANDS_HZ`) reaches above the road's
+    input (``meta["road_input_top_hz"]``, :func:`road_input_band`); [] where it is not known."""
+    top = (meta or {}).get("road_input_top_hz")
+    if top is None:
+        return []
+    return [k for k, (_, hi) in FINDING_BANDS_HZ.items() if hi > float(top)]
+
+
+def input_band_note(meta: Mapping | None) -> str | None:
+    """One sentence for the findings' readers where the road's input ends inside a finding's
+    band (None otherwise)."""
+    ids = findings_beyond_input(meta)
+    if not ids:
+        return None
+    top, n_top = float(meta["road_input_top_hz"]), float(meta["road_content_top_cpm"])
+    bands = ", ".join(f"({k}) {FINDING_BANDS_HZ[k][0]:g}-{FINDING_BANDS_HZ[k][1]:g} Hz" for k in ids)
+    return (f"The road holds no wavelength shorter than {1.0 / n_top:.2f} m (content up to "
+            f"{n_top:.2f} cycles/m), so at {float(meta.get('speed_mps', float('nan'))):g} m/s its "
+            f"input ends at {top:.1f} Hz: above that the spectra are not a response to the road. "
+            f"Judged on bands reaching beyond it: {bands} -- read these on a road with shorter "
+            f"waves (e.g. `eroad road generate --nmax 5 --dx 0.05`) before drawing a conclusion.")
 
 
 @dataclass
@@ -1197,6 +1245,11 @@ def findings_markdown(findings: list[Finding], meta: dict | None = None) -> str:
                      f"x{meta.get('mount_factor')}, {meta.get('speed_mps')} m/s, "
                      f"{meta.get('duration_s', 0) - meta.get('t_skip_s', 0):.1f} s analysed.")
         lines.append("")
+    note = input_band_note(meta)
+    if note:
+        lines.append(f"**Road input band.** {note}")
+        lines.append("")
+    beyond = set(findings_beyond_input(meta))
     lines.append(f"P = power spectrum (mean square per bin), P_s = P smoothed over "
                  f"{SMOOTH_HZ:g} Hz (Hann-weighted), f_peak = frequency of the largest P_s "
                  f"in (0, {F_MAX:g}] Hz, E = band mean square; `X_max_6_10Hz_over_max` = "
@@ -1228,7 +1281,9 @@ def findings_markdown(findings: list[Finding], meta: dict | None = None) -> str:
                f"(ratio {p['dominant']['ratio']:.2f})" if p["dominant"]["label"]
                else ", no resonance near (quasi-static / spectral shape)")
             for p in fd.peaks if p.get("mode"))
-        lines.append(f"| ({fd.id}) | {fd.claim} | **{'true' if fd.holds else 'false'}** | "
+        caveat = (f" (road input ends at {float(meta['road_input_top_hz']):.1f} Hz)"
+                  if fd.id in beyond else "")
+        lines.append(f"| ({fd.id}) | {fd.claim} | **{'true' if fd.holds else 'false'}**{caveat} | "
                      f"{fd.criterion} | {vals} | {mods or '-'} |")
     lines.append("")
     return "\n".join(lines)
@@ -1258,7 +1313,7 @@ def write_findings(findings: list[Finding], folder: str | Path, meta: dict | Non
                                          for k, v in CRITERIA.items()},
                             "smooth_hz": SMOOTH_HZ, "findings": [f.to_dict() for f in findings]})
     pm = folder / "findings.md"
-    tmp = folder / f".findings.md.tmp"
+    tmp = folder / ".findings.md.tmp"
     tmp.write_text(findings_markdown(findings, meta), encoding="utf-8")
     tmp.replace(pm)
     return pj, pm
@@ -1327,6 +1382,10 @@ def run_figure11(road_path: str | Path, out_root: str | Path = "results", *,
             "cond_A": saved.meta.get("cond"),
             "findings": {f.id: bool(f.holds) for f in findings},
             "findings_claims": {f.id: f.claim for f in findings},
+            "road_content_top_cpm": saved.meta.get("road_content_top_cpm"),
+            "road_input_top_hz": saved.meta.get("road_input_top_hz"),
+            "findings_beyond_road_input": findings_beyond_input(saved.meta),
+            "road_input_note": input_band_note(saved.meta),
             "kinematics_check": {
                 "cond": chk.get("cond"), "cond_exact_with_yaw": chk.get("cond_exact"),
                 "exact_max_rel_error": max(chk["exact"]["rel_error"][c] for c in COMPONENTS)

@@ -67,3 +67,32 @@ def test_bad_inputs_refused():
         fit_iso_psd((n, np.zeros_like(n)))
     with pytest.raises(EroadInputError, match="0 < low < high"):
         fit_iso_psd((n, n ** -2), band=(1, 0.5))
+
+
+@pytest.mark.parametrize("nmax, dx", [(2.83, 0.1), (1.5, 0.1), (0.6, 0.1), (5.0, 0.05)])
+def test_content_top_finds_the_synthesis_band_edge(nmax, dx):
+    """A road synthesised up to nmax carries nothing above it (the band edge drops 4-10
+    decades within a bin): ``content_top`` returns nmax to one Welch bin plus the Hann
+    window's leakage (2 bins, 0.04 cycles/m on a 300 m profile) -- on w 2 and on a steep w 3.2."""
+    from roadlib.metrics import content_top
+
+    for w in (2.0, 3.2):
+        z = synth_profile(SpectralParams(Gq_n0=256e-6, w=w, nmax=nmax, dx=dx), 300.0, seed=3)
+        z = z[1] if isinstance(z, tuple) else z
+        est = profile_psd(z, dx)
+        assert content_top(est) == pytest.approx(nmax, abs=2 * est.n[1]), w
+
+
+def test_content_top_is_the_grid_limit_where_the_road_has_content_to_it():
+    """A road whose band reaches the grid's Nyquist frequency, and the measured road profile of
+    ../shared/data/iri (0.25 m steps, a real road: no synthesis edge), end at 1/(2 dx) exactly."""
+    from pathlib import Path
+
+    from roadlib.metrics import content_top
+
+    z = synth_profile(SpectralParams(Gq_n0=4e-3, w=1.6, nmax=5.0, dx=0.1), 300.0, seed=3)
+    z = z[1] if isinstance(z, tuple) else z
+    assert content_top(profile_psd(z, 0.1)) == pytest.approx(5.0)
+    # copy of ../shared/data/iri/profile_1.txt kept beside the tests (tests/data/iri/PROVENANCE.md)
+    d = np.loadtxt(Path(__file__).resolve().parent / "data" / "iri" / "profile_1.txt")
+    assert content_top(profile_psd(d[:, 1], 0.25)) == pytest.approx(2.0)

@@ -24,7 +24,8 @@ import pytest
 
 from eroad.cli import main
 from studies.figure11 import (CRITERIA, _solve_exact_with_yaw, development_road,
-                              drive_base_motion, evaluate_findings, findings_markdown,
+                              drive_base_motion, evaluate_findings, findings_beyond_input,
+                              findings_markdown, road_input_band,
                               kinematics_check, load_figure11, plot_figure11, simulate_tractor,
                               tractor_variant, write_findings)
 from studies.pantograph import check_points, point_displacements, solve_base_motion
@@ -120,6 +121,30 @@ def test_findings_on_synthetic_signal_with_known_peaks():
     assert md.count("**true**") == 5
 
 
+def test_findings_judged_beyond_the_roads_input_say_so(short_road):
+    """A road synthesised over ISO 8608's band (nmax 2.83 cycles/m) driven at 10 m/s gives no
+    input above 28.3 Hz: findings (c) 15-35 Hz and (e) 20-40 Hz are judged partly on spectra
+    that are no response to the road, and the findings say so (the note, the column, the
+    summary); the 6-10 Hz and < 0.5 Hz findings are not flagged.  The edge is read from the
+    road itself (``roadlib.metrics.surface_content_top``) to one Welch bin (0.04 cycles/m on
+    this 200 m road); at 20 m/s it lies at 56.6 Hz, above every band."""
+    from roadlib.surface import RoadSurface
+    from roadlib.synthesis import SpectralParams, synth_surface
+
+    road = synth_surface(SpectralParams(Gq_n0=256e-6, nmax=2.83, dx=0.1, dy=0.1), 200.0, 2.0, seed=4)
+    assert isinstance(road, RoadSurface)
+    band = road_input_band(road, 10.0)
+    assert band["road_content_top_cpm"] == pytest.approx(2.83, abs=0.08)
+    meta = {"vehicle": "e_tractor", "speed_mps": 10.0, **band}
+    assert findings_beyond_input(meta) == ["c", "e"]
+    assert findings_beyond_input(dict(meta, **road_input_band(road, 20.0))) == []
+    assert findings_beyond_input({}) == [] and findings_beyond_input(None) == []
+    md = findings_markdown(evaluate_findings(_synthetic_motion(True), FS), meta)
+    assert "**Road input band.**" in md and "(c) 15-35 Hz, (e) 20-40 Hz" in md
+    assert md.count("(road input ends at 28.") == 2
+    assert "| (a) | pitch Ry dominates below 0.5 Hz | **true** |" in md
+
+
 def test_findings_files(tmp_path):
     found = evaluate_findings(_synthetic_motion(True), FS)
     pj, pm = write_findings(found, tmp_path, {"vehicle": "e_tractor"})
@@ -168,6 +193,13 @@ def test_eroad_study_pantograph_archives_a_run(short_road, tmp_path, capsys):
     assert md.count("**true**") == sum(on_disk.values())
     assert md.count("**false**") == 5 - sum(on_disk.values())
     assert summary["kinematics_check"]["exact_max_rel_error"] < 1e-9
+    # the development road is synthesised up to 5 cycles/m on a 0.05 m grid: at 10 m/s its
+    # input reaches 50 Hz, above every finding's band (one Welch bin of the road, 0.02-0.1
+    # cycles/m, is the resolution of the edge found)
+    assert summary["road_content_top_cpm"] == pytest.approx(5.0, abs=0.1)
+    assert summary["road_input_top_hz"] == pytest.approx(50.0, abs=1.0)
+    assert summary["findings_beyond_road_input"] == [] and summary["road_input_note"] is None
+    assert "Road input band" not in md and "road input ends" not in md
     assert set(data.spectra) >= {"Rx", "Rx_vel", "Rx_acc", "Ty_acc", "Tz_vel", "Ry_acc"}
     assert data.contributions["ratio"].shape[2] == 4
     # the figure: a PNG, and drawn again from the data alone
