@@ -830,10 +830,25 @@ def run_chassis_study(road_path: str | Path, out_root: str | Path = "results",
         run.write_json("roads.json", roads)
         figs = plot_chassis_study(run.data_dir, run.figures_dir)
         summary = _summary(tables, sweep, config, how)
+        summary.update(_road_input(road_path, config.speed))
         summary["figures"] = [str(p.relative_to(run.path)) for p in figs]
         run.write_summary(summary)
     summary["path"] = str(run.path)
     return summary
+
+
+def _road_input(road_path, speed: float) -> dict:
+    """Where the road file's input ends (:func:`studies.figure11.road_input_band`) and the
+    study bands (:data:`studies.pantograph.BANDS`) reaching above it: there an energy's
+    dependence on the frame is the vehicle ringing, not its response to short road waves.
+    The equivalent realisations share the file's segments and spectra, so its band too."""
+    from roadlib.surface import RoadSurface
+
+    from studies.figure11 import road_input_band
+
+    band = road_input_band(RoadSurface.load(road_path), speed)
+    beyond = [band_label(b) for b in BANDS if b[1] > band["road_input_top_hz"]]
+    return {**band, "bands_beyond_road_input": beyond}
 
 
 def _summary(tables: dict, sweep, config: StudyConfig, how: str) -> dict:

@@ -165,6 +165,11 @@ def _cmd_chassis(args: argparse.Namespace) -> int:
     print("frame modes [Hz] (torsion, bending) by frame factor: "
           + "; ".join(f"{k}: {v['torsion_hz']:.2f}, {v['bending_hz']:.2f}"
                       for k, v in summary["frame_modes_hz"].items() if k != "rigid"))
+    if summary.get("bands_beyond_road_input"):
+        print(f"road input: the road's content ends at {summary['road_content_top_cpm']:.2f} "
+              f"cycles/m, {summary['road_input_top_hz']:.1f} Hz at this speed; band(s) "
+              f"{', '.join(b + ' Hz' for b in summary['bands_beyond_road_input'])} reach beyond it (no road input "
+              "there: use a road with shorter waves, e.g. `eroad road generate --nmax 5 --dx 0.05`)")
     print("bands whose energy changes with the frame stiffness (softest vs rigid, every "
           f"road, factor > {summary['trend_threshold']:g}):")
     for q, bands in summary["bands_depending_on_frame"].items():

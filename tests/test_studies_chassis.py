@@ -60,6 +60,24 @@ def test_quick_study_runs_serially_and_archives(quick_runs):
     # 4 frames x 1 mount x 2 roads x 12 quantities x 4 bands
     assert len(df) == 4 * 1 * 2 * 12 * 4
     assert (df["energy"] > 0).all()
+    # the development road carries content to 5 cycles/m (50 Hz at 10 m/s): no band of the
+    # study (to 40 Hz) lies beyond the road's input; one Welch bin of the 95 m road (0.1
+    # cycles/m) is the resolution of the edge
+    assert first["road_input_top_hz"] == pytest.approx(50.0, abs=1.0)
+    assert first["bands_beyond_road_input"] == []
+
+
+def test_bands_beyond_a_roads_input_are_named(tmp_path):
+    """A road made over ISO 8608's band (nmax 2.83 cycles/m) ends at 28.3 Hz at 10 m/s:
+    the 15-40 Hz band is named as reaching beyond the road's input."""
+    from roadlib.synthesis import SpectralParams, synth_surface
+    from studies.chassis_study import _road_input
+
+    path = tmp_path / "iso.npz"
+    synth_surface(SpectralParams(Gq_n0=256e-6, nmax=2.83), 200.0, 2.0, seed=2).save(path)
+    r = _road_input(path, 10.0)
+    assert r["road_input_top_hz"] == pytest.approx(28.3, abs=0.8)
+    assert r["bands_beyond_road_input"] == ["15-40"]
 
 
 def test_frame_modes_rise_with_stiffness(quick_runs):
