@@ -481,14 +481,21 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
         R = D["residual"]
         L.append("## What is left\n")
         model = "the nominal model" if R["model"] == "nominal" else f"the model with {R['model']}"
+        closest = D.get("closest")
+        share = D.get("explained_share")
+        if share is None:
+            share_text = ""
+        else:
+            who = (f"The effect, {R['model']}," if R["model"] != "nominal" else
+                   f"The closest effect, {closest}," if closest else None)
+            share_text = ("" if who is None else
+                          f" {who} explains {share:.0%} of the gap above a correct model's (a named "
+                          f"effect needs {D['thresholds']['share_min']:.0%}).")
         L.append(f"Held-out gap of {model}: {_fmt(R['heldout_gap'])}; a correct model reaches "
                  f"{_fmt(R['correct_model_gap'])} +- {_fmt(R['correct_model_sd'], '{:.2g}')} "
-                 f"(the nominal model scored against surrogate measurements it made itself); the "
-                 f"nominal model: {_fmt(R['nominal_gap'])}."
-                 + (f" The explained share of the gap above a correct model's is "
-                    f"{D['explained_share']:.0%} (a named effect needs "
-                    f"{D['thresholds']['share_min']:.0%})." if D.get("explained_share") is not None
-                    else ""))
+                 f"(the nominal model scored against surrogate measurements it made itself)"
+                 + (f"; the nominal model: {_fmt(R['nominal_gap'])}." if R["model"] != "nominal"
+                    else ".") + share_text)
         if R.get("bands_left"):
             L.append(" Bands furthest above the sampling floor: "
                      + ", ".join(f"{b['band_centre_hz']:.3g} Hz ({b['gap']:.3g} against "

@@ -255,3 +255,28 @@ def test_how_far_does_not_call_an_accepted_candidate_not_accepted():
     txt = render_markdown(s, {})
     assert "accepted by the ranking but not named by the verdict" in txt
     assert "NOT accepted" not in txt
+
+
+def test_what_is_left_names_whose_share_it_gives():
+    """"What is left" gives the explained share of the gap: on an `unexplained` drive whose
+    residual is the nominal model's (no candidate reduced the gap), the share is the closest
+    effect's and is said to be (it read "The explained share ... is 7%" beside "the nominal
+    model" written twice); where the residual is a candidate's, that candidate's.  Saved blind
+    summaries of the independent truck (stop 63's fresh set: drives 6 and 1)."""
+    from pathlib import Path
+
+    from diagnosis.report import render_markdown
+
+    root = Path(__file__).resolve().parents[1] / "results" / "diagnosis_blind" / \
+        "20261130-fresh-40-stop63" / "second"
+
+    def left(case):
+        md = render_markdown(json.loads((root / f"case{case:03d}-summary.json").read_text()), {})
+        return md.split("## What is left", 1)[1].split("##", 1)[0]
+
+    txt = left(6)
+    assert "Held-out gap of the nominal model:" in txt and txt.count("the nominal model:") == 1
+    assert "The closest effect, speed_scale, explains 7% of the gap above a correct model's" in txt
+    txt = left(1)
+    assert "Held-out gap of the model with leaf_friction:" in txt and "the nominal model: " in txt
+    assert "The effect, leaf_friction, explains 86% of the gap above a correct model's" in txt
