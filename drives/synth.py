@@ -56,6 +56,7 @@ from scipy.interpolate import PchipInterpolator
 
 from drives.format import TRUTH_DIR, ZERO_NOMINAL_STATIC, _umask, read_drive, write_drive
 from eroad.errors import EroadInputError
+from roadlib.profiles import bandlimited_profile  # noqa: F401  (drives.synth.bandlimited_profile: the name the scenarios and tests use)
 
 #: folder of the built-in scenario files
 SCENARIO_DIR = Path(__file__).with_name("scenarios")
@@ -487,9 +488,10 @@ def read_profile(name: str, src="profile") -> tuple[np.ndarray, np.ndarray]:
 
     The straight line fitted by least squares (grade and level) is removed.
     """
+    from roadlib.profiles import detrend_profile
+
     data = np.loadtxt(_profile_file(name, src))
-    x = data[:, 0] - data[0, 0]
-    z = data[:, 1] - np.polyval(np.polyfit(x, data[:, 1], 1), x)
+    x, z, _ = detrend_profile(data[:, 0], data[:, 1])
     return x, z
 
 
@@ -511,48 +513,6 @@ def _profile_segment(name: str, src) -> dict:
     gq = float(10 ** icpt)
     return {"proportion": 1.0, "Gq_n0": gq, "w": float(-slope), "nmin": 0.05, "nmax": 2.0,
             "label": class_of(gq)}
-
-
-def bandlimited_profile(xp, zp, dx: float) -> tuple[np.ndarray, np.ndarray]:
-    """A uniformly sampled profile on a grid at least as fine as ``dx``, band-limited.
-
-    A profile measured every ``dxp`` holds the road up to its Nyquist wavenumber
-    1 / (2 dxp) (2 cycles/m for the 0.25 m of profile_1) and nothing above.  Linear
-    interpolation onto a finer road grid is a low-pass inside that band (power factor
-    sinc^4(n dxp): 0.66 at 1 cycle/m, 0.40 at 1.5 cycles/m for 0.25 m) plus images above
-    it, so the road the truck drove was steeper (w 3.65-3.73 over the driven windows for
-    the file's 2.95).  Here the profile is upsampled by an integer factor m with
-    ``dxp / m <= dx / 4`` by zero-padding its spectrum (the even extension of the profile
-    first, so the periodic wrap adds no step): the band up to 1 / (2 dxp) keeps its power,
-    nothing is added above it.  The caller's linear read-out of the fine grid then loses
-    at most sinc^4(1 / 8) = 0.90 of the power at the profile's Nyquist wavenumber and
-    under 1 % below half of it.
-
-    Parameters
-    ----------
-    xp, zp : ndarray
-        Chainage [m] (uniform step) and height [m].
-    dx : float
-        Road grid step [m].
-
-    Returns
-    -------
-    xf, zf : ndarray
-        Fine chainage [m] (same start and end as ``xp``) and height [m].
-    """
-    from scipy.signal import resample
-
-    xp, zp = np.asarray(xp, float), np.asarray(zp, float)
-    steps = np.diff(xp)
-    dxp = float(np.mean(steps))
-    if np.ptp(steps) > 1e-6 * dxp:
-        raise EroadInputError(f"measured profile: chainage step varies ({steps.min():g}-{steps.max():g} m); "
-                              f"a uniform step is needed")
-    m = max(1, int(math.ceil(4.0 * dxp / dx - 1e-9)))
-    ext = np.concatenate([zp, zp[-2:0:-1]])          # even extension: period 2 (N - 1) samples
-    fine = resample(ext, m * ext.size)
-    n = (zp.size - 1) * m + 1
-    return xp[0] + np.arange(n) * (dxp / m), fine[:n]
 
 
 def profile_mix_weight(y, width: float):

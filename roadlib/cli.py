@@ -268,6 +268,46 @@ def cmd_generate(args) -> int:
     return 0
 
 
+def cmd_from_profile(args) -> int:
+    from roadlib.metrics import surface_content_top
+    from roadlib.profiles import surface_from_profiles
+
+    out = Path(args.out)
+    if out.suffix.lower() not in (".npz", ".crg"):
+        raise EroadInputError(f"--out {out}: use a .npz or .crg file name")
+    if not out.parent.exists():
+        raise EroadInputError(f"--out {out}: folder {out.parent} does not exist")
+    summary_path = out.with_name(out.name + ".summary.json")
+    _refuse_existing(out, args.force)
+    _refuse_existing(summary_path, args.force)
+    left = read_profile_text(args.profile)
+    right = read_profile_text(args.right) if args.right else None
+    surf = surface_from_profiles(left, right, track_width=args.track_width, width=args.width,
+                                 dx=args.dx, dy=args.dy,
+                                 names=(str(args.profile), str(args.right)))
+    surf.meta["command"] = "eroad road from-profile"
+    surf.meta["profiles"] = [str(Path(args.profile).resolve())] + (
+        [str(Path(args.right).resolve())] if args.right else [])
+    n_top = surface_content_top(surf)
+    surf.save(out, overwrite=True)
+    summary = {"command": "road from-profile", "out": str(out), "profiles": surf.meta["profiles"],
+               "surface": surf.summary(), "lateral": surf.meta["lateral"],
+               "grades": surf.meta["grades"], "source_x_start_m": surf.meta["source_x_start_m"],
+               "content_top_cpm": n_top,
+               "no_roll_input": right is None}
+    _write_text_atomic(summary_path, json.dumps(summary, indent=2) + "\n")
+    grades = ", ".join(f"{100 * g:+.2f} %" for g in surf.meta["grades"])
+    msg = (f"wrote {out} ({surf.x.size} x {surf.y.size} grid, {surf.length:g} m x {surf.width:g} m; "
+           f"chainage {surf.meta['source_x_start_m']:g} m is x = 0; grade removed: {grades}); "
+           f"{surf.meta['lateral']}; content up to {n_top:.2f} cycles/m (a vehicle at v m/s gets "
+           f"no road input above {n_top:.2f} v Hz); summary {summary_path}")
+    if right is None:
+        msg += ("\nnote: one profile drives both wheel tracks alike, so the vehicle gets no roll "
+                "input from the road; give the other wheel track with --right where it was measured")
+    _print(args, summary, msg)
+    return 0
+
+
 def cmd_psd(args) -> int:
     from roadlib.metrics import default_band, fit_iso_psd, profile_psd
     from roadlib.surface import RoadSurface
@@ -378,8 +418,8 @@ def _nonneg(text):
 
 
 def register(subparsers) -> None:
-    """Add ``eroad road {generate,psd,iri,plot}`` to the top-level subparsers."""
-    road = subparsers.add_parser("road", help="ISO 8608 roads: generate, PSD, IRI, plot",
+    """Add ``eroad road {generate,from-profile,psd,iri,plot}`` to the top-level subparsers."""
+    road = subparsers.add_parser("road", help="ISO 8608 roads: generate, from a measured profile, PSD, IRI, plot",
                                  description="ISO 8608 road surfaces (roadlib).")
     sub = road.add_subparsers(dest="road_command", metavar="ACTION")
 
@@ -414,6 +454,29 @@ def register(subparsers) -> None:
     g.add_argument("--force", action="store_true", help="overwrite existing output files")
     g.add_argument("--json", action="store_true", help="print the summary as JSON")
     g.set_defaults(func=cmd_generate)
+
+    fp = sub.add_parser("from-profile", help="a road file from measured wheel-track profiles",
+                        description="Make a road surface (.npz or .crg) of a measured longitudinal "
+                        "profile (two columns x [m], z [m], a uniform step), or of two: the left "
+                        "and right wheel tracks. Each profile is detrended (its least-squares line, "
+                        "the grade, removed and reported) and band-limited onto the road grid (no "
+                        "content added above its Nyquist wavenumber); across the road the height is "
+                        "linear between the two tracks and held beyond. One profile drives both "
+                        "tracks alike (no roll input). Then: eroad simulate --road FILE. "
+                        "docs/roadlib.md, 'Measured profiles'.")
+    fp.add_argument("profile", help="the (left) wheel-track profile: x [m] z [m] text")
+    fp.add_argument("--right", default=None, metavar="PROFILE",
+                    help="the right wheel-track profile on the same chainage")
+    fp.add_argument("--track-width", type=positive_float, default=1.8,
+                    help="lateral distance between the two profiles [m] (default 1.8)")
+    fp.add_argument("--width", type=positive_float, default=3.0,
+                    help="road width [m], centred on y = 0 (default 3)")
+    fp.add_argument("--dx", type=positive_float, default=0.05, help="grid step along the road [m] (0.05)")
+    fp.add_argument("--dy", type=positive_float, default=0.05, help="grid step across the road [m] (0.05)")
+    fp.add_argument("--out", required=True, metavar="FILE", help="output road file, .npz or .crg")
+    fp.add_argument("--force", action="store_true", help="overwrite existing output files")
+    fp.add_argument("--json", action="store_true", help="print the summary as JSON")
+    fp.set_defaults(func=cmd_from_profile)
 
     p = sub.add_parser("psd", help="Welch PSD and ISO 8608 fit of a road or profile",
                        description="Estimate the displacement PSD (Welch, cycles/m) and fit Gd(n0) [m^3] and w "

@@ -290,7 +290,10 @@ class RoadSurface:
             return cls(x, y, z, meta)
         if suffix == ".crg":
             return cls._read_crg(path)
-        raise EroadInputError(f"{path}: unknown road file type {path.suffix!r}; use .npz or .crg")
+        raise EroadInputError(f"{path}: unknown road file type {path.suffix!r}; use .npz or .crg"
+                              + (" (a measured profile, x [m] z [m]? `eroad road from-profile "
+                                 f"{path.name} --out road.npz` makes a road of it)"
+                                 if path.suffix.lower() in (".txt", ".csv", ".dat", ".prn") else ""))
 
     def _write_crg(self, path, meta_json: str, shown=None) -> None:
         import pycrg
