@@ -196,12 +196,9 @@ def _print(args, summary: dict, text: str) -> None:
 
 
 # ----------------------------------------------------------------------------- commands
-def cmd_generate(args) -> int:
-    from roadlib.metrics import default_band, fit_iso_psd, profile_psd
-    from roadlib.psd import class_gd0
-    from roadlib.segments import RoadSegment, segmented_surface
-    from roadlib.synthesis import SpectralParams, synth_surface
-
+def _road_outputs(args) -> tuple[Path, Path]:
+    """The road file ``--out`` (.npz or .crg, in an existing folder) and its summary beside
+    it, both refused where they exist unless ``--force``."""
     out = Path(args.out)
     if out.suffix.lower() not in (".npz", ".crg"):
         raise EroadInputError(f"--out {out}: use a .npz or .crg file name")
@@ -210,6 +207,16 @@ def cmd_generate(args) -> int:
     summary_path = out.with_name(out.name + ".summary.json")
     _refuse_existing(out, args.force)
     _refuse_existing(summary_path, args.force)
+    return out, summary_path
+
+
+def cmd_generate(args) -> int:
+    from roadlib.metrics import default_band, fit_iso_psd, profile_psd
+    from roadlib.psd import class_gd0
+    from roadlib.segments import RoadSegment, segmented_surface
+    from roadlib.synthesis import SpectralParams, synth_surface
+
+    out, summary_path = _road_outputs(args)
     if args.seed < 0:
         raise EroadInputError(f"--seed must be a non-negative integer, got {args.seed}")
     spec = {"w": args.w, "nmin": args.nmin, "nmax": args.nmax, "lam": args.lam}
@@ -272,14 +279,7 @@ def cmd_from_profile(args) -> int:
     from roadlib.metrics import surface_content_top
     from roadlib.profiles import surface_from_profiles
 
-    out = Path(args.out)
-    if out.suffix.lower() not in (".npz", ".crg"):
-        raise EroadInputError(f"--out {out}: use a .npz or .crg file name")
-    if not out.parent.exists():
-        raise EroadInputError(f"--out {out}: folder {out.parent} does not exist")
-    summary_path = out.with_name(out.name + ".summary.json")
-    _refuse_existing(out, args.force)
-    _refuse_existing(summary_path, args.force)
+    out, summary_path = _road_outputs(args)
     left = read_profile_text(args.profile)
     right = read_profile_text(args.right) if args.right else None
     surf = surface_from_profiles(left, right, track_width=args.track_width, width=args.width,
