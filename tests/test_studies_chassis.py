@@ -61,9 +61,10 @@ def test_quick_study_runs_serially_and_archives(quick_runs):
     assert len(df) == 4 * 1 * 2 * 12 * 4
     assert (df["energy"] > 0).all()
     # the development road carries content to 5 cycles/m (50 Hz at 10 m/s): no band of the
-    # study (to 40 Hz) lies beyond the road's input; one Welch bin of the 95 m road (0.1
-    # cycles/m) is the resolution of the edge
-    assert first["road_input_top_hz"] == pytest.approx(50.0, abs=1.0)
+    # study (to 40 Hz) lies beyond the road's input; two Welch bins of the 95 m road (2 x
+    # 0.078 cycles/m, 1.6 Hz at 10 m/s; the Hann window leaks the edge a bin or two) are the
+    # resolution of the edge
+    assert first["road_input_top_hz"] == pytest.approx(50.0, abs=2.0)
     assert first["bands_beyond_road_input"] == []
 
 

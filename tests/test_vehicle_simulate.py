@@ -189,8 +189,13 @@ def test_cli_simulate_and_effects(tmp_path, capsys):
     assert code == 0
     assert {p.name for p in out.iterdir()} >= {"channels.csv", "meta.toml", "summary.json"}
     # the count printed is the one `eroad data check` gives: 24 channels, speed apart
-    assert "24 channels + speed" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "24 channels + speed" in printed
     summary = json.loads((out / "summary.json").read_text())
+    # where the road's input ends, at the drive's top speed (7 m/s): printed and recorded
+    assert "road input: the road carries wavelengths down to" in printed
+    assert summary["road_input_top_hz_at_max_speed"] == pytest.approx(
+        7.0 * summary["road_content_top_cpm"], rel=1e-3)
     for key in ("realtime_factor", "wall_s", "steps"):
         assert key in summary
     assert summary["effects"]["leaf_friction"]["force"] == 1500.0
