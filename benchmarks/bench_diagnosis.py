@@ -63,12 +63,14 @@ def main(argv=None) -> int:
     ap.add_argument("--folds", type=int, choices=(1, 2), default=None,
                     help="ranking folds (default: that of diagnosis.blind.BLIND_SETTINGS)")
     ap.add_argument("--n-null", type=int, default=None,
-                    help="null cases among them (default: a fifth, family second: half)")
+                    help="null cases among them (default: a fifth, families second and measured: half)")
     ap.add_argument("--null-only", action="store_true",
                     help="every case a null drive (the extra null validation: --seed 1)")
-    ap.add_argument("--family", choices=("nominal", "second"), default="nominal",
-                    help="truth family: the Exudyn truck plus one effect (nominal), or the "
-                         "independently written truck with out-of-library differences (second)")
+    ap.add_argument("--family", choices=("nominal", "second", "measured"), default="nominal",
+                    help="truth family: the Exudyn truck plus one effect (nominal), the "
+                         "independently written truck with out-of-library differences (second), "
+                         "or the Exudyn truck on the measured road profile (measured: no vehicle "
+                         "difference, a real road)")
     ap.add_argument("--vehicle", default=None,
                     help="truth and model vehicle of family nominal (built-in id or TOML; default "
                          "the dump truck); payload strengths scaled by its nominal payload, the "

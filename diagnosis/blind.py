@@ -82,7 +82,14 @@ BLIND_SETTINGS = dict(BUDGET, pairs=False)
 #: mounts, progressive tyres with lift-off, axle-guide geometry), plus one library effect
 #: it also models (leaf friction, payload) or none; its null cases carry only the
 #: out-of-library differences, and "none" or "unexplained" is the right answer there.
-FAMILIES = {"nominal": ("null", tuple(STRENGTHS)), "second": ("second", ("leaf_friction", "payload"))}
+#: ``measured`` (stop 64): the Exudyn truck itself, as ``nominal``, but every drive on the measured
+#: road profile (scenario ``null_measured``): no vehicle difference at all, so a gap on its null
+#: cases is the real road's misfit with the diagnosis's road model -- what ``second``'s
+#: measured-profile drives mix with that truck's structural differences.
+FAMILIES = {"nominal": ("null", tuple(STRENGTHS)), "second": ("second", ("leaf_friction", "payload")),
+            "measured": ("null_measured", tuple(STRENGTHS))}
+#: dataset-seed offset of each family (so that families never share a drive)
+FAMILY_SEED_OFFSET = {"nominal": 0, "second": 50000, "measured": 70000}
 #: in the ``second`` family every ``MEASURED_EVERY``-th case (case 0, 4, 8, ...) drives the
 #: measured road profile (scenario ``second_measured``) instead of a synthetic ISO road
 MEASURED_EVERY = 4
@@ -122,9 +129,10 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
         half of them).
     effects : sequence of str, optional
         Effects used (default all the family can carry, :data:`FAMILIES`).
-    family : {"nominal", "second"}
-        Truth family (:data:`FAMILIES`); ``second`` case seeds are offset by 50000, and
-        every :data:`MEASURED_EVERY`-th of its cases drives the measured road profile.
+    family : {"nominal", "second", "measured"}
+        Truth family (:data:`FAMILIES`); case seeds are offset by :data:`FAMILY_SEED_OFFSET`;
+        every :data:`MEASURED_EVERY`-th case of ``second`` drives the measured road profile,
+        every case of ``measured``.
     vehicle : str, optional
         Truth and model vehicle (family ``nominal`` only; default the scenario's, the dump
         truck): a payload change is scaled by its nominal payload (``STRENGTH_PAYLOAD_KG``);
@@ -147,7 +155,7 @@ def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
         raise ValueError(f"family {family} carries {', '.join(fam_effects)}; not {', '.join(bad)}")
     if n_null is None:
         n_null = max(1, round(n / 5)) if family == "nominal" else n // 2
-    off = 0 if family == "nominal" else 50000
+    off = FAMILY_SEED_OFFSET[family]
     null_at = set(np.linspace(0, n - 1, n_null).round().astype(int).tolist()) if n_null else set()
     cases, k = [], 0
     for i in range(n):
@@ -230,7 +238,7 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
     # scoring only from here: truth is read
     truth = read_truth(ds)
     truth_eff = (truth.get("vehicle", {}).get("truth", {}) or {}).get("effects") or {}
-    if case.get("family", "nominal") != "nominal":
+    if case.get("family", "nominal") == "second":
         truth_eff = {}      # no oracle: the Exudyn model with the effect is not the truth
     case = dict(case, seed=int(truth.get("seed", case["seed"])))   # the seed actually used
     verdict = summ["verdict"]

@@ -61,7 +61,7 @@ from roadlib.profiles import bandlimited_profile  # noqa: F401  (drives.synth.ba
 #: folder of the built-in scenario files
 SCENARIO_DIR = Path(__file__).with_name("scenarios")
 #: built-in scenario names
-SCENARIOS = ("luliang", "random", "null", "second", "second_measured")
+SCENARIOS = ("luliang", "random", "null", "null_measured", "second", "second_measured")
 #: spawn keys of the random streams (see module docstring)
 STREAM_DRAWS, STREAM_SPEED, STREAM_ROAD, STREAM_NOISE, STREAM_VEHICLE = 0, 1, 2, 3, 4
 STREAM_TRUTH_OPTIONS = 5

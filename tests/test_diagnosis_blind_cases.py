@@ -33,3 +33,19 @@ def test_another_vehicle_gets_the_same_draws_its_payload_scaled():
 def test_the_independent_truck_family_refuses_another_vehicle():
     with pytest.raises(ValueError, match="nominal family only"):
         make_cases(4, 1, family="second", vehicle="e_tractor")
+
+
+def test_the_measured_road_family_drives_the_nominal_truck_on_the_profile():
+    """Family ``measured``: every case on scenario ``null_measured`` (the nominal truck on the
+    measured profile), half of them null, the nominal family's effects and strengths in turn,
+    dataset seeds offset by 70000 so that no drive is another family's."""
+    from diagnosis.blind import FAMILY_SEED_OFFSET
+
+    m = make_cases(16, 431, family="measured")
+    assert {c["scenario"] for c in m} == {"null_measured"} and {c["family"] for c in m} == {"measured"}
+    assert sum(c["effect"] == "none" for c in m) == 8
+    assert [c["seed"] for c in m] == [1000 * 431 + 70100 + i for i in range(16)]
+    seeds = {f: {c["seed"] for c in make_cases(16, 431, family=f)} for f in FAMILY_SEED_OFFSET}
+    assert not (seeds["measured"] & seeds["nominal"]) and not (seeds["measured"] & seeds["second"])
+    effects = [c["effect"] for c in m if c["effect"] != "none"]
+    assert len(set(effects)) == 8
