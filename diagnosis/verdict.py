@@ -141,6 +141,19 @@ FULL_GAP_Z = 2.0
 #: docs/diagnosis.md, "A vehicle effect taking most of the gap, named as a vehicle
 #: difference").  None: off.
 VEHICLE_SHARE_MIN = 0.6
+#: low-pass effects: a causal low-pass of the recorded channels (``sensor``) or a spatial
+#: low-pass of the road input (``tyre_enveloping``).  Their filter acts on the axle and the body
+#: acceleration alike, so every channel ratio -- the axle-to-body transmissibility included --
+#: cancels it: the transmissibility "agrees" with such a candidate because the effect leaves it
+#: where the nominal model had it, which confirms nothing; and their roll-off has the shape of
+#: a road's own high-band roll-off.  Measured (stop 64,
+#: results/diagnosis_blind/20261130-measured-road-nominal/): our own truck, no effect, on the
+#: measured road profile -- a sensor named on 5 of 8 drives, 2 of them `clear`, and tyre
+#: enveloping `clear` on a drive without it.  So a low-pass name is never `clear` (nor
+#: "identified"): a caveat says why and what to check.  The name itself stays (on synthetic
+#: roads it is right in most cases); the speed dependence that could separate a sensor from the
+#: road (its cutoff fixed in Hz, a road's in cycles/m) is not built.
+LOWPASS_EFFECTS = ("sensor", "tyre_enveloping")
 #: the smallest deviation from "no effect" the verdict names, per effect: effect ->
 #: (parameter, neutral value, smallest relative deviation).  A winner calibrated closer to
 #: neutral than this is not named: it is no cause a user could act on, only a knob that took up
@@ -938,6 +951,14 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"; one fold's calibration lay at an edge of the search range, the other's inside, and "
             f"the whole record fits the inside value better (gap summed over both window sets "
             f"{wr[1 - dropped]:.3g} against {wr[dropped]:.3g}): the value is that fold's -- not 'clear'")
+    lowpass = win["effect"] in LOWPASS_EFFECTS
+    if lowpass:
+        caveats.append(
+            f"; {win['effect']} is a low-pass ({'of the recorded channels' if win['effect'] == 'sensor' else 'of the road under the tyres'}): "
+            "it acts on the axle and the body alike, so no channel ratio (the transmissibility "
+            "included) can confirm it, and its roll-off looks like the road's own -- on our truck "
+            "driven over a measured road profile a sensor was named on 5 of 8 drives without one: "
+            "check the logger's filter settings and the tyres before acting on it -- not 'clear'")
     z_abs = improvement_z(win)
     weak = z_abs is not None and z_abs < CLEAR_Z_MIN
     if weak:
@@ -960,7 +981,7 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     # correct: what a correction may use
     return dict(out, verdict=rv, confidence=conf, reason=reason,
                 identified=bool(rd.get("confidence") == "clear" and not edges and gap_present
-                                and not weak and not on_gap_alone and not on_signature
+                                and not weak and not lowpass and not on_gap_alone and not on_signature
                                 and not as_vehicle and not st.corroborated and dropped is None),
                 named_on=("gap_alone" if on_gap_alone else "vehicle_share" if as_vehicle
                           else "signature" if on_signature else None))

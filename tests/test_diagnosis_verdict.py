@@ -443,3 +443,27 @@ def test_without_an_axle_and_body_acceleration_pair_the_signature_is_unconfirmed
     # 50 %: unexplained
     d = decide(bare(after=1.0 - 0.5 * 0.6))
     assert d["verdict"] == "unexplained" and "no wheel station with both an axle and a body" in d["reason"]
+
+
+def test_a_low_pass_effect_is_never_clear():
+    """A sensor low-pass or tyre enveloping acts on axle and body alike, so the transmissibility
+    "agreeing" with it confirms nothing; on our own truck driven over the measured road profile
+    a sensor was named `clear` on drives without one (stop 64).  Saved blind summaries: the name
+    stays, the confidence is `ambiguous` with the reason, and it is not "identified" -- a wrong
+    one (measured-road set, case 4: no effect in the truth) and a right one (stop 64's fresh
+    set, case 19: a 9.0 Hz sensor); another effect decided from the same kind of record keeps
+    `clear` (case 7 of that set: speed scale)."""
+    import json
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1] / "results" / "diagnosis_blind"
+    load = lambda p: json.loads((root / p).read_text())
+    wrong = decide(load("20261130-measured-road-nominal/measured/case004-summary.json"))
+    right = decide(load("20261130-fresh-40-stop64/nominal/case019-summary.json"))
+    for d in (wrong, right):
+        assert d["verdict"] == "sensor" and d["confidence"] == "ambiguous"
+        assert not d["identified"]
+        assert "no channel ratio (the transmissibility included) can confirm it" in d["reason"]
+        assert d["reason"].endswith("-- not 'clear'")
+    other = decide(load("20261130-fresh-40-stop64/nominal/case007-summary.json"))
+    assert other["verdict"] == "speed_scale" and other["confidence"] == "clear"
