@@ -894,9 +894,10 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
 
     # --- named: the reason, and each caveat that keeps it from "clear"
     conf = rd.get("confidence", "clear")
+    lowpass = win["effect"] in LOWPASS_EFFECTS
     reason = rd.get("reason") or ""
     reason += (f"; it explains {share:.0%} of the gap above a correct model's"
-               + ("" if agrees is not True or remainder or own_res is not None else
+               + ("" if agrees is not True or remainder or own_res is not None or lowpass else
                   f"; its {what} agrees with the measurement")
                + remainder)
     if own_res is not None:
@@ -951,12 +952,12 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"; one fold's calibration lay at an edge of the search range, the other's inside, and "
             f"the whole record fits the inside value better (gap summed over both window sets "
             f"{wr[1 - dropped]:.3g} against {wr[dropped]:.3g}): the value is that fold's -- not 'clear'")
-    lowpass = win["effect"] in LOWPASS_EFFECTS
     if lowpass:
         caveats.append(
             f"; {win['effect']} is a low-pass ({'of the recorded channels' if win['effect'] == 'sensor' else 'of the road under the tyres'}): "
-            "it acts on the axle and the body alike, so no channel ratio (the transmissibility "
-            "included) can confirm it, and its roll-off looks like the road's own -- on our truck "
+            "it acts on the axle and the body alike, so no channel ratio can confirm it (the "
+            "transmissibility agrees because the effect leaves it where it was), and its roll-off "
+            "looks like the road's own -- on our truck "
             "driven over a measured road profile a sensor was named on 5 of 8 drives without one: "
             "check the logger's filter settings and the tyres before acting on it -- not 'clear'")
     z_abs = improvement_z(win)

@@ -463,7 +463,8 @@ def test_a_low_pass_effect_is_never_clear():
     for d in (wrong, right):
         assert d["verdict"] == "sensor" and d["confidence"] == "ambiguous"
         assert not d["identified"]
-        assert "no channel ratio (the transmissibility included) can confirm it" in d["reason"]
+        assert "no channel ratio can confirm it (the transmissibility agrees because" in d["reason"]
+        assert "its axle-to-body transmissibility agrees with the measurement" not in d["reason"]
         assert d["reason"].endswith("-- not 'clear'")
     other = decide(load("20261130-fresh-40-stop64/nominal/case007-summary.json"))
     assert other["verdict"] == "speed_scale" and other["confidence"] == "clear"
