@@ -172,19 +172,20 @@ def test_identical_inputs_are_reported_unresolved_not_a_number():
     assert ok.n_unresolved == 0 and ok.resolved.all()
 
 
-def _summary(sig1, sig2=None):
+def _summary(sig1, sig2=None, effect="tyre_enveloping", param=("length", 0.3, [0.1, 1.0, False])):
+    pname, value, rng = param
     s = {"nominal": {"heldout_gap": 3.0, "null_gap_mean": 1.0, "null_gap_std": 0.1,
                      "gap_present": True},
-         "ranking_decision": {"verdict": "tyre_enveloping", "confidence": "clear", "reason": "r"},
-         "ranking": [{"effect": "tyre_enveloping", "accepted": True, "heldout_gap_before": 3.0,
+         "ranking_decision": {"verdict": effect, "confidence": "clear", "reason": "r"},
+         "ranking": [{"effect": effect, "accepted": True, "heldout_gap_before": 3.0,
                       # 1.5: 5 sd above a correct model's gap, so the signature decides (not the
                       # gap alone, diagnosis.verdict.FULL_GAP_Z)
-                      "heldout_gap_after": 1.5, "parameters": {"tyre_enveloping": {"length": 0.3}}}],
-         "meta": {"search_ranges": {"tyre_enveloping": {"length": [0.1, 1.0, False]}}},
-         "signature": {"model": "tyre_enveloping", "chi2_nominal": sig1[0], "chi2_model": sig1[1],
+                      "heldout_gap_after": 1.5, "parameters": {effect: {pname: value}}}],
+         "meta": {"search_ranges": {effect: {pname: rng}}},
+         "signature": {"model": effect, "chi2_nominal": sig1[0], "chi2_model": sig1[1],
                        "n_cells": 100, "pairs_off": []}}
     if sig2 is not None:
-        s["signature_two_input"] = {"model": "tyre_enveloping", "chi2_nominal": sig2[0],
+        s["signature_two_input"] = {"model": effect, "chi2_nominal": sig2[0],
                                     "chi2_model": sig2[1], "n_cells": sig2[2], "pairs_off": [],
                                     "method": "two_input"}
     return s
@@ -199,7 +200,14 @@ def test_verdict_uses_the_two_input_signature_and_falls_back_clearly():
     d = decide(s, signature_method="two_input")
     assert d["verdict"] == "tyre_enveloping" and d["signature_method"] == "two_input"
     assert d["thresholds"]["signature_method"] == "two_input"
-    assert "two-input" in d["reason"]
+    # a low-pass winner's reason does not claim the transmissibility's agreement (it confirms
+    # nothing for a filter on axle and body alike, diagnosis.verdict.LOWPASS_EFFECTS); another
+    # effect's names the two-input record it was decided on
+    assert "agrees with the measurement" not in d["reason"]
+    f = _summary((5.25, 5.20), (0.79, 0.86, 155), effect="frame_flex",
+                 param=("stiffness_factor", 3.0, [0.05, 10000.0, True]))
+    df = decide(f, signature_method="two_input")
+    assert df["verdict"] == "frame_flex" and "two-input" in df["reason"]
     d1 = decide(s)   # the default (docs/diagnosis.md: not two-input yet)
     assert d1["verdict"] == "unexplained" and d1["signature_method"] == "single_input"
     old = _summary((5.25, 5.20))
