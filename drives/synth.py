@@ -56,7 +56,7 @@ from scipy.interpolate import PchipInterpolator
 
 from drives.format import TRUTH_DIR, ZERO_NOMINAL_STATIC, _umask, read_drive, write_drive
 from eroad.errors import EroadInputError
-from roadlib.profiles import bandlimited_profile  # noqa: F401  (drives.synth.bandlimited_profile: the name the scenarios and tests use)
+from roadlib.profiles import bandlimited_profile, detrend_profile
 
 #: folder of the built-in scenario files
 SCENARIO_DIR = Path(__file__).with_name("scenarios")
@@ -488,8 +488,6 @@ def read_profile(name: str, src="profile") -> tuple[np.ndarray, np.ndarray]:
 
     The straight line fitted by least squares (grade and level) is removed.
     """
-    from roadlib.profiles import detrend_profile
-
     data = np.loadtxt(_profile_file(name, src))
     x, z, _ = detrend_profile(data[:, 0], data[:, 1])
     return x, z

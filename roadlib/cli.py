@@ -26,6 +26,7 @@ import numpy as np
 
 from eroad.argtypes import positive_float
 from eroad.errors import EroadInputError
+from roadlib.profiles import DEFAULT_TRACK_WIDTH_M, DEFAULT_WIDTH_M
 
 SEGMENT_KEYS = {"class", "Gq_n0", "length", "w", "nmin", "nmax", "lambda"}
 
@@ -467,10 +468,10 @@ def register(subparsers) -> None:
     fp.add_argument("profile", help="the (left) wheel-track profile: x [m] z [m] text")
     fp.add_argument("--right", default=None, metavar="PROFILE",
                     help="the right wheel-track profile on the same chainage")
-    fp.add_argument("--track-width", type=positive_float, default=1.8,
-                    help="lateral distance between the two profiles [m] (default 1.8)")
-    fp.add_argument("--width", type=positive_float, default=3.0,
-                    help="road width [m], centred on y = 0 (default 3)")
+    fp.add_argument("--track-width", type=positive_float, default=DEFAULT_TRACK_WIDTH_M,
+                    help=f"lateral distance between the two profiles [m] (default {DEFAULT_TRACK_WIDTH_M:g})")
+    fp.add_argument("--width", type=positive_float, default=DEFAULT_WIDTH_M,
+                    help=f"road width [m], centred on y = 0 (default {DEFAULT_WIDTH_M:g})")
     fp.add_argument("--dx", type=positive_float, default=0.05, help="grid step along the road [m] (0.05)")
     fp.add_argument("--dy", type=positive_float, default=0.05, help="grid step across the road [m] (0.05)")
     fp.add_argument("--out", required=True, metavar="FILE", help="output road file, .npz or .crg")

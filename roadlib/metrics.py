@@ -326,3 +326,18 @@ def surface_content_top(road, n_tracks: int = 5) -> float:
     cols = np.unique(np.linspace(0, y.size - 1, min(int(n_tracks), y.size)).round().astype(int))
     z = np.asarray(road.z, float)[:, cols]
     return content_top(profile_psd(z, float(road.dx)))
+
+
+#: how to make a road whose input reaches further up (the project's development road's band):
+#: the hint the studies print where a road's input ends inside their bands
+SHORT_WAVE_ROAD_HINT = "eroad road generate --nmax 5 --dx 0.05"
+
+
+def road_input_band(road, speed: float) -> dict:
+    """Where a road's input to a vehicle ends: ``road_content_top_cpm``, the highest spatial
+    frequency the road carries (:func:`surface_content_top`: a synthesis band's nmax, or the
+    grid's Nyquist frequency), and ``road_input_top_hz`` = that times ``speed`` [m/s].  Above it
+    a vehicle's responses hold no response to the road (a road made with ISO 8608's default
+    band, nmax 2.83 cycles/m, ends at 28.3 Hz at 10 m/s)."""
+    n_top = float(surface_content_top(road))
+    return {"road_content_top_cpm": n_top, "road_input_top_hz": n_top * float(speed)}

@@ -838,13 +838,12 @@ def run_chassis_study(road_path: str | Path, out_root: str | Path = "results",
 
 
 def _road_input(road_path, speed: float) -> dict:
-    """Where the road file's input ends (:func:`studies.figure11.road_input_band`) and the
+    """Where the road file's input ends (:func:`roadlib.metrics.road_input_band`) and the
     study bands (:data:`studies.pantograph.BANDS`) reaching above it: there an energy's
     dependence on the frame is the vehicle ringing, not its response to short road waves.
     The equivalent realisations share the file's segments and spectra, so its band too."""
+    from roadlib.metrics import road_input_band
     from roadlib.surface import RoadSurface
-
-    from studies.figure11 import road_input_band
 
     band = road_input_band(RoadSurface.load(road_path), speed)
     beyond = [band_label(b) for b in BANDS if b[1] > band["road_input_top_hz"]]

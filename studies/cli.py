@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 from typing import Any
 
 from eroad.archive import NOT_RECORDED, RunRecord, find_run, list_runs
@@ -84,7 +85,6 @@ def _cmd_list(args: argparse.Namespace) -> int:
         print(json.dumps([_row(r) for r in records], indent=2))
         return 0
     if not records:
-        from pathlib import Path
         missing = "" if Path(args.root).is_dir() else " (no such folder)"
         print(f"no runs under {args.root}{missing}")
         return 0

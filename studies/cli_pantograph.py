@@ -20,6 +20,7 @@ import json
 import sys
 
 from eroad.errors import EroadInputError
+from roadlib.metrics import SHORT_WAVE_ROAD_HINT
 
 from eroad.argtypes import positive_float
 
@@ -169,7 +170,7 @@ def _cmd_chassis(args: argparse.Namespace) -> int:
         print(f"road input: the road's content ends at {summary['road_content_top_cpm']:.2f} "
               f"cycles/m, {summary['road_input_top_hz']:.1f} Hz at this speed; band(s) "
               f"{', '.join(b + ' Hz' for b in summary['bands_beyond_road_input'])} reach beyond it (no road input "
-              "there: use a road with shorter waves, e.g. `eroad road generate --nmax 5 --dx 0.05`)")
+              f"there: use a road with shorter waves, e.g. `{SHORT_WAVE_ROAD_HINT}`)")
     print("bands whose energy changes with the frame stiffness (softest vs rigid, every "
           f"road, factor > {summary['trend_threshold']:g}):")
     for q, bands in summary["bands_depending_on_frame"].items():

@@ -37,6 +37,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from eroad.errors import EroadInputError, SimulationError
+from roadlib.metrics import SHORT_WAVE_ROAD_HINT, road_input_band
 from studies.pantograph import (QUANTITIES, amplitude_spectrum, check_points,
                                 point_displacements, power_spectrum, solve_base_motion)
 
@@ -960,18 +961,6 @@ FINDING_BANDS_HZ = {"a": (0.0, 0.5), "b": (6.0, 10.0), "c": (15.0, 35.0), "d": (
                     "e": (20.0, F_MAX)}
 
 
-def road_input_band(road, speed: float) -> dict:
-    """Where the road's input to the vehicle ends: ``road_content_top_cpm``, the highest
-    spatial frequency the road file carries (:func:`roadlib.metrics.surface_content_top`: its
-    synthesis band's nmax, or its grid's Nyquist frequency), and ``road_input_top_hz`` = that
-    times the speed.  Above it the spectra hold no response to the road (a road made with
-    ISO 8608's default band, nmax 2.83 cycles/m, ends at 28.3 Hz at 10 m/s)."""
-    from roadlib.metrics import surface_content_top
-
-    n_top = float(surface_content_top(road))
-    return {"road_content_top_cpm": n_top, "road_input_top_hz": n_top * float(speed)}
-
-
 def findings_beyond_input(meta: Mapping | None) -> list[str]:
     """The findings whose claimed band (:data:`FINDING_BANDS_HZ`) reaches above the road's
     input (``meta["road_input_top_hz"]``, :func:`road_input_band`); [] where it is not known."""
@@ -993,7 +982,7 @@ def input_band_note(meta: Mapping | None) -> str | None:
             f"{n_top:.2f} cycles/m), so at {float(meta.get('speed_mps', float('nan'))):g} m/s its "
             f"input ends at {top:.1f} Hz: above that the spectra are not a response to the road. "
             f"Judged on bands reaching beyond it: {bands} -- read these on a road with shorter "
-            f"waves (e.g. `eroad road generate --nmax 5 --dx 0.05`) before drawing a conclusion.")
+            f"waves (e.g. `{SHORT_WAVE_ROAD_HINT}`) before drawing a conclusion.")
 
 
 @dataclass

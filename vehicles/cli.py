@@ -126,14 +126,15 @@ def cmd_simulate(args) -> int:
     summary = res.summary()
     summary.update({"command": "simulate", "argv": sys.argv[1:], "vehicle_file": str(vpath),
                     "road_file": str(args.road), "out": str(out)})
-    # where the road's input ends: above n_top x speed [Hz] the responses hold no road input
-    from roadlib.metrics import surface_content_top
+    # where the road's input ends: above it at the drive's top speed the channels hold no road input
+    from roadlib.metrics import road_input_band
 
-    n_top = float(surface_content_top(road))
     v_max = (max(float(v) for v in res.channels["speed"]) if "speed" in res.channels
              else float(summary.get("speed_mean", float("nan"))))
+    band = road_input_band(road, v_max)
+    n_top = band["road_content_top_cpm"]
     summary["road_content_top_cpm"] = n_top
-    summary["road_input_top_hz_at_max_speed"] = n_top * v_max
+    summary["road_input_top_hz_at_max_speed"] = band["road_input_top_hz"]
 
     def add(folder: Path) -> None:
         with open(folder / "summary.json", "w") as fh:
@@ -150,7 +151,7 @@ def cmd_simulate(args) -> int:
               f"{' + speed' if 'speed' in res.channels else ''} at {m['fs_out']:g} Hz; {m['steps']} steps in "
               f"{m['wall_s']:.2f} s wall ({m['realtime_factor']:.0f}x real time)")
         print(f"road input: the road carries wavelengths down to {1.0 / n_top:.2f} m ({n_top:.2f} "
-              f"cycles/m), so above {n_top * v_max:.1f} Hz (at {v_max:.3g} m/s) the channels hold no "
+              f"cycles/m), so above {band['road_input_top_hz']:.1f} Hz (at {v_max:.3g} m/s) the channels hold no "
               "road input")
     return 0
 
