@@ -724,6 +724,14 @@ def _road_text(summary: Mapping) -> list:
     for r in rows:
         L.append(f"| {r['segment']} | {t0 + r['t_start_s']:.1f}-{t0 + r['t_end_s']:.1f} | "
                  f"{r['Gq_n0_m3']:.3g} | {r['w']:.2f} | {r['nmin']:g} | {r['nmax']:g} |")
+    feats = meta.get("local_road_features_s") or []
+    if feats:
+        L.append("\nLocal road feature(s) at " + ", ".join(f"{t0 + a:.1f}-{t0 + b:.1f} s" for a, b in feats)
+                 + ": segment(s) shorter than one period of the lowest band the waviness fit uses, cut "
+                 "by the segmentation around a stretch whose level differs from the road about it (a "
+                 "joint, a patch, a step). No random-road model represents one, so these seconds are "
+                 "left out of the calibration and held-out windows (the road under them is still "
+                 "driven); they still show in the localisation above.")
     wr = meta.get("road_w_range")
     if wr:
         at = [r["segment"] for r in rows if min(abs(r["w"] - wr[0]), abs(r["w"] - wr[1])) < 1e-9]

@@ -80,6 +80,11 @@ def road_segments(sig: Signals, k=None):
 
 
 W_RANGE = (1.2, 3.0)
+#: segments too short for the waviness regression take the nearest fitted segment's w
+#: (stop 65): left at the reference road's 2 on a road of w 3, the half-second segment around
+#: a local feature of a measured profile simulated 40-270 times the measured power at
+#: 22-56 Hz, which a sensor low-pass then "explained" (measured-road family, seed 431)
+WAVINESS_FILL = True
 #: lowest spatial frequency of the road [cycles/m] tried per segment by :func:`fit_nmin`:
 #: ISO 8608's lowest classified frequency (0.011) up to the 0.1 of the virtual test drive;
 #: real and ISO roads carry power down to 0.01 cycles/m, and a road fixed at 0.1 left the
@@ -98,6 +103,22 @@ FIT_NMIN = True
 NMIN_LOW_BAND, NMIN_REF_BAND = (0.25, 1.25), (2.0, 8.0)
 #: quantities of the low-band fit (road-driven below the body bounce: suspension travel)
 NMIN_QUANTITIES = ("susp_disp_",)
+
+
+def nearest_fill(values, has, bounds) -> np.ndarray:
+    """``values`` per segment with those where ``has`` is False replaced by the value of the
+    segment whose middle is nearest (in record time, ``bounds`` [s]) among those where it is
+    True: a segment too short for a statistic takes the record's road next to it.  Unchanged
+    when no segment (or every one) has it."""
+    out = np.array(values, float)
+    has = np.asarray(has, bool)
+    if has.any() and not has.all():
+        b = np.asarray(bounds, float)
+        mid = 0.5 * (b[1:] + b[:-1])
+        src = np.nonzero(has)[0]
+        for k in np.nonzero(~has)[0]:
+            out[k] = out[src[int(np.argmin(np.abs(mid[src] - mid[k])))]]
+    return out
 
 
 def _runs(mask):
@@ -436,12 +457,7 @@ def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | No
     # segments too short for the statistic take the value of the nearest one that has it
     # (the record's road: a short segment left at 5 between cut ones put the whole excess
     # back for its seconds)
-    has = np.isfinite(d[g0])
-    if has.any() and not has.all():
-        mid = 0.5 * (np.asarray(model.bounds[1:]) + np.asarray(model.bounds[:-1]))
-        src = np.nonzero(has)[0]
-        for k in np.nonzero(~has)[0]:
-            out[k] = out[src[int(np.argmin(np.abs(mid[src] - mid[k])))]]
+    out = nearest_fill(out, np.isfinite(d[g0]), model.bounds)
     model.nmax = out
     model.high_band = {"cut": [int(k) for k in np.nonzero(out < ROAD_NMAX)[0]],
                        "rolloff": list(rolloff), "vetoed": bool(vetoed)}
@@ -479,6 +495,7 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0, mapper
     bands = third_octave_bands(*W_FIT_BAND)
     wchan = [c for c in model.channels if c.startswith(W_FIT_QUANTITIES)] or list(model.channels)
     gq, w = np.empty(K), np.full(K, ROAD_W)
+    w_fitted = np.zeros(K, bool)
     for k in range(K):
         a, b = int(round(model.bounds[k] * fs)), int(round(model.bounds[k + 1] * fs))
         m = np.zeros_like(calmask)
@@ -499,9 +516,15 @@ def fit_road(model: TruckModel, sig: Signals, calib_edges, seed: int = 0, mapper
             if len(set(np.round(xs, 6))) >= 3:
                 slope = float(np.polyfit(xs, ys, 1)[0])
                 w[k] = float(np.clip(ROAD_W - slope, *W_RANGE))
+                w_fitted[k] = True
         # level over all channels with the fitted tilt applied to the reference simulation
         logs = _level_logs(model, sig, sim, mk)
         gq[k] = GQ_REF * math.exp(float(np.mean(logs))) if logs else GQ_REF
+    # a segment too short for the waviness regression (no 256-sample run: the half-second
+    # segments the segmentation puts around a local road feature) takes the waviness of the
+    # nearest segment that has one, not the reference road's 2 (WAVINESS_FILL)
+    if WAVINESS_FILL:
+        w = nearest_fill(w, w_fitted, model.bounds)
     # the level above was measured with w = 2; choose nmin with the fitted w, then
     # re-simulate once with both and re-level
     model.w = w

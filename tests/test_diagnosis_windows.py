@@ -1,0 +1,62 @@
+"""The diagnosis's calibration / held-out windows, and local road features cut out of them
+(``diagnosis.pipeline.windows``, ``local_features``, ``window_pieces``; stop 65).
+
+No simulation: the windows are cut from a synthetic record.
+"""
+import numpy as np
+import pytest
+
+from diagnosis.pipeline import (LOCAL_FEATURE_MAX_S, MIN_WINDOW_PIECE_S, local_features,
+                                window_pieces, windows)
+from diagnosis.signals import Signals
+from eroad.errors import EroadInputError
+
+
+def _record(T=30.0, fs=200.0):
+    t = np.arange(int(T * fs)) / fs
+    return Signals(t, {"susp_disp_3L": np.sin(t)}, {"susp_disp_3L": "m"}, np.full(t.size, 9.0),
+                   {"dataset": "x"})
+
+
+def test_local_features_are_the_segments_shorter_than_one_period_of_the_lowest_fit_band():
+    # the segments of blind case 0 of the measured-road family (seed 431): a half-second piece
+    # around a local road feature, then two long segments
+    bounds = [0.0, 1.05, 1.55, 23.3, 30.0]
+    assert LOCAL_FEATURE_MAX_S == pytest.approx(1.0)
+    assert local_features(bounds) == [(1.05, 1.55)]
+    assert local_features([0.0, 12.0, 30.0]) == []
+
+
+def test_window_pieces_cut_out_the_features_and_drop_short_rests():
+    assert window_pieces(0.0, 7.5) == [(0.0, 7.5)]
+    # the 1.05 s left before the feature is shorter than a usable piece: dropped
+    assert window_pieces(0.0, 7.5, [(1.05, 1.55)]) == [(1.55, 7.5)]
+    assert window_pieces(0.0, 7.5, [(3.0, 3.5)]) == [(0.0, 3.0), (3.5, 7.5)]
+    # features outside the window, or straddling its edge
+    assert window_pieces(7.5, 15.0, [(1.05, 1.55), (14.8, 15.3)]) == [(7.5, 14.8)]
+    assert window_pieces(0.0, 7.5, [(2.0, 3.0), (4.0, 4.6)]) == [(0.0, 2.0), (4.6, 7.5)]
+    assert all(b - a >= MIN_WINDOW_PIECE_S for a, b in window_pieces(0.0, 7.5, [(1.9, 2.1)]))
+
+
+def test_windows_carry_their_pieces_times_and_samples():
+    sig = _record()
+    cal, held, edges, cal_e, held_e = windows(sig, 4)
+    assert np.allclose(edges, [0, 7.5, 15, 22.5, 30])
+    assert cal_e == [(0.0, 7.5), (15.0, 22.5)] and held_e == [(7.5, 15.0), (22.5, 30.0)]
+    cal, held, edges, cal_e, held_e = windows(sig, 4, [(1.05, 1.55), (10.0, 10.5)])
+    assert cal_e == [(1.55, 7.5), (15.0, 22.5)]
+    assert held_e == [(7.5, 10.0), (10.5, 15.0), (22.5, 30.0)]
+    for w, (a, b) in zip(cal + held, cal_e + held_e):
+        assert w.meta["t0"] == a
+        assert w.time.size == pytest.approx((b - a) * sig.fs, abs=1)
+        # the piece's samples are the record's from its start
+        i0 = int(round(a * sig.fs))
+        assert np.array_equal(w.channels["susp_disp_3L"], sig.channels["susp_disp_3L"][i0:i0 + w.time.size])
+    assert [w.meta["window"] for w in held] == [2, 2, 4]
+
+
+def test_a_record_whose_held_out_windows_are_all_features_is_refused_in_one_line():
+    sig = _record(T=8.0)
+    with pytest.raises(EroadInputError, match="no calibration or no held-out window") as e:
+        windows(sig, 4, [(2.0, 4.0), (6.0, 8.0)])
+    assert "\n" not in str(e.value)
