@@ -256,7 +256,17 @@ def segment_label(summary: Mapping, seg: str) -> str:
     if seg == "all" or seg not in times:
         return seg
     a, b = times[seg]
-    return f"{seg} ({a:.1f}-{b:.1f} s)"
+    return f"{seg} ({a:.1f}-{b:.1f} s{', local road feature' if _is_local_feature(summary, seg) else ''})"
+
+
+def _is_local_feature(summary: Mapping, seg: str) -> bool:
+    """Is segment ``seg`` one of the local road features left out of the windows
+    (``meta.local_road_features_s``, diagnosis-relative times)?"""
+    feats = (summary.get("meta") or {}).get("local_road_features_s") or []
+    st = summary.get("localization_settings") or {}
+    w = dict(zip(st.get("segments", []), st.get("windows_s", []))).get(seg)
+    return w is not None and any(abs(float(w[0]) - a) < 1e-6 and abs(float(w[1]) - b) < 1e-6
+                                 for a, b in feats)
 
 
 def plot_segments(summary: Mapping, path: str | os.PathLike) -> Path:

@@ -60,3 +60,21 @@ def test_a_record_whose_held_out_windows_are_all_features_is_refused_in_one_line
     with pytest.raises(EroadInputError, match="no calibration or no held-out window") as e:
         windows(sig, 4, [(2.0, 4.0), (6.0, 8.0)])
     assert "\n" not in str(e.value)
+
+
+def test_the_report_names_a_left_out_local_feature():
+    from diagnosis.report import _road_text, segment_label
+
+    rows = [{"segment": f"S{k + 1}", "t_start_s": a, "t_end_s": b, "Gq_n0_m3": 1e-4, "w": 3.0,
+             "nmin": 0.1, "nmax": 2.0} for k, (a, b) in enumerate([(0.0, 1.05), (1.05, 1.55), (1.55, 30.0)])]
+    summary = {"meta": {"record_t0_s": 100.0, "local_road_features_s": [[1.05, 1.55]],
+                        "road_segments": rows},
+               "localization_settings": {"segments": ["all", "S1", "S2", "S3"],
+                                         "windows_s": [[0.0, 30.0], [0.0, 1.05], [1.05, 1.55], [1.55, 30.0]]}}
+    assert segment_label(summary, "S2") == "S2 (101.0-101.5 s, local road feature)"
+    assert segment_label(summary, "S3") == "S3 (101.5-130.0 s)"
+    text = "\n".join(_road_text(summary))
+    assert "Local road feature(s) at 101.0-101.5 s" in text and "left out" in text
+    summary["meta"]["local_road_features_s"] = []
+    assert "Local road feature" not in "\n".join(_road_text(summary))
+    assert segment_label(summary, "S2") == "S2 (101.0-101.5 s)"
