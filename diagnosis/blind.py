@@ -113,6 +113,19 @@ def nominal_payload(vehicle) -> float:
     return -float(get_effect("payload").vehicle_ranges(load_vehicle(vehicle))["mass"][0])
 
 
+def reported_nmax(summary) -> list | None:
+    """The road band of the pass a diagnosis reported, where a band refit or the joint band
+    moved it from the first fit (``meta.band_refit`` / ``meta.joint_band``), else None."""
+    meta = summary.get("meta") or {}
+    joint = meta.get("joint_band") or {}
+    if joint.get("chosen") == "cut" and joint.get("nmax_after"):
+        return list(joint["nmax_after"])
+    refit = meta.get("band_refit") or {}
+    if refit.get("changed") and refit.get("nmax_after"):
+        return list(refit["nmax_after"])
+    return None
+
+
 def make_cases(n: int, seed: int = 0, n_null: int | None = None, effects=None,
                family: str = "nominal", vehicle=None) -> list[dict]:
     """``n`` blind cases: effects in turn (strength drawn per case), every ``k``-th a null case.
@@ -249,7 +262,8 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
         oracle = {k: dict(v) for k, v in truth_eff.items()}
         if "sensor" in oracle:        # the nominal model carries the measured noise floor
             oracle["sensor"].update(acc_noise=0.0, disp_noise=0.0)
-        hs = heldout_shrink(blind, oracle, n_seeds=settings["n_seeds"], n_null=settings["n_null"])
+        hs = heldout_shrink(blind, oracle, n_seeds=settings["n_seeds"], n_null=settings["n_null"],
+                            nmax=reported_nmax(summ))
         true_shrink, true_z = hs["shrink_fraction"], hs["paired_z"]
     t3 = _time.perf_counter()
     detail = summ.get("verdict_detail") or {}

@@ -451,11 +451,17 @@ def gap_terms(model: TruckModel, sig: Signals) -> list:
 
 
 def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: int = 4,
-                   n_windows: int = 4, n_null: int = 12, delay: bool = True) -> dict:
+                   n_windows: int = 4, n_null: int = 12, delay: bool = True, nmax=None) -> dict:
     """Held-out gap of the nominal model and of the model with ``effects`` (given, not
     calibrated), on the seeds ``rank_effects`` uses: the "true shrink" of a blind case
     when ``effects`` is the truth, and whether that model would pass the ranking's paired
     gate.
+
+    ``nmax``: the road's top spatial frequency per segment [cycles/m] the diagnosis ended
+    with, where its band refit or joint band moved it (``meta.joint_band.nmax_after`` when the
+    cut was chosen); the levels are then refitted on it as :func:`diagnose` does.  Default: the
+    band :func:`prepare` fits (before stop 65 always this, so on a drive whose reported pass ran
+    on a cut road the true shrink was measured on another road than the verdict's).
 
     Returns
     -------
@@ -469,6 +475,13 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
     drive, sig = load_measured(dataset)
     ctx = prepare(sig, vehicle if vehicle is not None else drive.vehicle, seed=seed,
                   n_windows=n_windows)
+    if nmax is not None:
+        m = ctx.model
+        m.nmax = np.asarray(nmax, float)
+        m.high_band = {"cut": [int(k) for k in np.nonzero(m.nmax < ROAD_NMAX)[0]],
+                       "rolloff": [], "vetoed": False}
+        m.gq = relevel_road(m, sig, ctx.cal_edges, m.gq, seed)
+        nominal_record(m, sig, seed)
     sc = _Scorer(Fit(ctx.model), Simulate(ctx.model), ctx.calib, ctx.held, seed, 1, n_seeds,
                  None, None)
     terms = gap_terms(ctx.model, sig) if delay else []

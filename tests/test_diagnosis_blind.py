@@ -89,3 +89,20 @@ def test_two_rules_are_scored_from_the_first_pass_kept_beside_the_final_verdict(
     score, times = two_rule_lines(rs, "joint_band")
     assert "named right 0/1" in score[0] and "named right 1/1" in score[1]
     assert "max 90.0 s, over 120 s: 0" in times[0] and "max 150.0 s, over 120 s: 1" in times[1]
+
+
+def test_the_oracle_runs_on_the_band_the_reported_pass_ran_on():
+    """The true shrink of a case is measured on the road the reported verdict's pass used: the
+    joint band's cut where it was chosen, else a band refit that moved nmax, else the fitted
+    band (stop 65: measured-road case 3 of seed 439 read -1.24 on the uncut road)."""
+    from diagnosis.blind import reported_nmax
+
+    assert reported_nmax({"meta": {}}) is None
+    cut = {"chosen": "cut", "nmax_before": [3.0, 5.0], "nmax_after": [2.0, 2.0]}
+    assert reported_nmax({"meta": {"joint_band": cut}}) == [2.0, 2.0]
+    kept = dict(cut, chosen="fitted")
+    assert reported_nmax({"meta": {"joint_band": kept}}) is None
+    refit = {"changed": True, "nmax_before": [5.0, 5.0], "nmax_after": [2.5, 5.0]}
+    assert reported_nmax({"meta": {"joint_band": kept, "band_refit": refit}}) == [2.5, 5.0]
+    assert reported_nmax({"meta": {"joint_band": cut, "band_refit": refit}}) == [2.0, 2.0]
+    assert reported_nmax({"meta": {"band_refit": dict(refit, changed=False)}}) is None
