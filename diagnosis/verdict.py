@@ -957,9 +957,9 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"; {win['effect']} is a low-pass ({'of the recorded channels' if win['effect'] == 'sensor' else 'of the road under the tyres'}): "
             "it acts on the axle and the body alike, so no channel ratio can confirm it (the "
             "transmissibility agrees because the effect leaves it where it was), and its roll-off "
-            "looks like the road's own -- on our truck "
-            "driven over a measured road profile a sensor was named on 5 of 8 drives without one: "
-            "check the logger's filter settings and the tyres before acting on it -- not 'clear'")
+            "looks like the road's own (a road whose short waves fall off faster than the fitted "
+            "road's reads the same): check the logger's filter settings and the tyres before "
+            "acting on it -- not 'clear'")
     z_abs = improvement_z(win)
     weak = z_abs is not None and z_abs < CLEAR_Z_MIN
     if weak:
