@@ -204,11 +204,16 @@ def windows(sig: Signals, n_windows: int = 4, exclude=()):
     the equal windows' edges [s], and the ``(start, end)`` [s] of every calibration and
     held-out piece
     """
-    T = sig.time.size / sig.fs
-    edges = np.linspace(0.0, T, n_windows + 1)
+    fs, N = sig.fs, sig.time.size
+    T = N / fs
+    # every edge on a sample: the simulation of a window starts at round(t0 * fs) and the
+    # measured window at the first sample at or after t0; an edge between samples (a record
+    # of 8001 samples cut in four) made them differ by one sample and stopped the ranking
+    edges = np.round(np.linspace(0.0, N, n_windows + 1)) / fs
     cal, held, cal_edges, held_edges = [], [], [], []
     for i in range(n_windows):
         for a, b in window_pieces(float(edges[i]), float(edges[i + 1]), exclude):
+            a, b = round(a * fs) / fs, round(b * fs) / fs
             w = sig.window(a, b)
             w = Signals(w.time, w.channels, w.units, w.speed, {**sig.meta, "t0": a, "window": i + 1})
             (cal if i % 2 == 0 else held).append(w)

@@ -78,3 +78,20 @@ def test_the_report_names_a_left_out_local_feature():
     summary["meta"]["local_road_features_s"] = []
     assert "Local road feature" not in "\n".join(_road_text(summary))
     assert segment_label(summary, "S2") == "S2 (101.0-101.5 s)"
+
+
+def test_window_edges_lie_on_samples_so_the_simulation_matches_the_window():
+    """A record of 8001 samples (``eroad simulate --duration 40`` writes both ends) cut in four
+    put edges between samples (20.0025 s); the simulated window then started one sample after the
+    measured one and the ranking stopped on '1999 samples, time has 2000' (stop 65, found as a
+    new user)."""
+    sig = _record(T=40.005)
+    assert sig.time.size == 8001
+    cal, held, edges, cal_e, held_e = windows(sig, 4, [(4.75, 5.30), (13.05, 13.55)])
+    for w, (a, b) in zip(cal + held, cal_e + held_e):
+        i0, i1 = round(a * sig.fs), round(b * sig.fs)
+        assert abs(a * sig.fs - i0) < 1e-9 and abs(b * sig.fs - i1) < 1e-9
+        # what diagnosis.truck_model.Simulate takes: t0 and the window's own length
+        t1 = w.meta["t0"] + w.time.size / sig.fs
+        assert round(t1 * sig.fs) - round(w.meta["t0"] * sig.fs) == w.time.size
+        assert w.time[0] == sig.time[i0]
