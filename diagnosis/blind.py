@@ -271,6 +271,7 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
                **judge(case, verdict, summ.get("verdict_confidence")),
                param_ratio=param_ratio(case, entry),
                ranking_verdict=detail.get("ranking_verdict"),
+               gap_side=(detail.get("gap_side") or {}).get("side"),
                explained_share=detail.get("explained_share"),
                signature=summ.get("signature"), summary=str(run / "summary.json"),
                localisation_hit=localisation_hit(summ, case["effect"], case["value"]),

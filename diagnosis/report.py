@@ -38,7 +38,7 @@ from matplotlib.figure import Figure
 
 from eroad.errors import EroadInputError
 
-from .verdict import decide, own_statistic
+from .verdict import GAP_SIDE_MEASURED, decide, own_statistic
 
 __all__ = ["build_summary", "write_report", "plot_heatmap", "plot_segments",
            "plot_transmissibility", "plot_ranking", "plot_shrink_bands", "render_markdown",
@@ -510,6 +510,31 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
             L.append(" Bands furthest above the sampling floor: "
                      + ", ".join(f"{b['band_centre_hz']:.3g} Hz ({b['gap']:.3g} against "
                                  f"{b['sampling_floor']:.3g})" for b in R["bands_left"]) + ".")
+        G = D.get("gap_side") if summary.get("verdict") == "unexplained" else None
+        if G:
+            if G["side"] == "road":
+                L.append(f" Road or vehicle: the nominal model's two-input axle-to-body "
+                         f"transmissibility agrees with the measurement (0 of {G['tested']} cells "
+                         "flagged), a comparison the road under the wheels does not enter -- so the gap "
+                         "most likely lies in the road model (a spectrum of another shape than ISO 8608's "
+                         "one or two slopes, local features) or in a vehicle difference too small for that "
+                         "comparison to see. On saved blind drives this read 'road' on "
+                         f"{GAP_SIDE_MEASURED['road'][0]} of {GAP_SIDE_MEASURED['road'][1]} drives of a "
+                         "correct vehicle model.")
+            else:
+                L.append(f" Road or vehicle: the nominal model's two-input axle-to-body "
+                         f"transmissibility differs from the measurement in {G['flagged']} of "
+                         f"{G['tested']} cells ({', '.join(G['pairs'][:4])}"
+                         + (", ..." if len(G['pairs']) > 4 else "") + "; bands "
+                         + ", ".join(f"{b:g}" for b in G["bands_hz"][:6])
+                         + (", ..." if len(G["bands_hz"]) > 6 else "") + " Hz), a comparison the road "
+                         "under the wheels does not enter -- so the vehicle differs from the model in "
+                         "a way no library effect represents. On saved blind drives this read "
+                         f"'vehicle' on {GAP_SIDE_MEASURED['vehicle'][0]} of "
+                         f"{GAP_SIDE_MEASURED['vehicle'][1]} drives of a truck that differs from ours.")
+        elif summary.get("verdict") == "unexplained" and "gap_side" in D:
+            L.append(" Road or vehicle: not told -- the record has no station with axle and body "
+                     "accelerations on both sides for the two-input transmissibility.")
         used = D.get("signature_method")
         if (D.get("signature_own") or {}).get("agrees") is not None:
             used = None         # the effect is tested on its own signature (below)

@@ -468,3 +468,62 @@ def test_a_low_pass_effect_is_never_clear():
         assert d["reason"].endswith("-- not 'clear'")
     other = decide(load("20261130-fresh-40-stop64/nominal/case007-summary.json"))
     assert other["verdict"] == "speed_scale" and other["confidence"] == "clear"
+
+
+def _two_input(flags):
+    """A two-input transmissibility record with the given flags (None: untested cell)."""
+    cells = [{"input": "axle_acc_1L", "output": "body_acc_1L", "band_centre_hz": 2.0 + i,
+              "p_value": None if f is None else (0.001 if f else 0.5), "significant": bool(f)}
+             for i, f in enumerate(flags)]
+    return {"transmissibility_two_input": {"cells": cells}}
+
+
+def test_gap_side_reads_the_nominal_two_input_transmissibility():
+    from diagnosis.verdict import GAP_SIDE_MIN_FLAGS, gap_side
+
+    assert GAP_SIDE_MIN_FLAGS == 1
+    assert gap_side({}) is None
+    assert gap_side(_two_input([None, None])) is None       # nothing tested: not told
+    g = gap_side(_two_input([False, False, None]))
+    assert g["side"] == "road" and g["flagged"] == 0 and g["tested"] == 2
+    g = gap_side(_two_input([False, True, None, True]))
+    assert g["side"] == "vehicle" and g["flagged"] == 2 and g["pairs"] == ["axle_acc_1L->body_acc_1L"]
+    assert g["bands_hz"] == [3.0, 5.0]
+
+
+def test_gap_side_on_saved_blind_drives_of_both_trucks():
+    """Our truck on the measured road with no effect (the road model is all that is wrong) reads
+    'road'; the independent truck with no library effect reads 'vehicle' (saved summaries of the
+    stop-65 set, seeds 439 and 443); the report says which, for an unexplained verdict only."""
+    import json
+    from pathlib import Path
+
+    from diagnosis.report import render_markdown
+    from diagnosis.verdict import gap_side
+
+    root = Path(__file__).resolve().parents[1] / "results/diagnosis_blind/20261130-local-features-stop65"
+    ours = json.loads((root / "measured/case000-summary.json").read_text())
+    other = json.loads((root / "second/case000-summary.json").read_text())
+    assert ours["verdict"] == other["verdict"] == "unexplained"
+    assert gap_side(ours)["side"] == "road"
+    assert gap_side(other)["side"] == "vehicle"
+    for s, word in ((ours, "most likely lies in the road model"), (other, "the vehicle differs")):
+        s = dict(s, verdict_detail=dict(s["verdict_detail"], gap_side=gap_side(s)))
+        assert word in render_markdown(s, {})
+    named = json.loads((root / "nominal/case001-summary.json").read_text())
+    assert named["verdict"] != "unexplained"
+    assert "Road or vehicle" not in render_markdown(named, {})
+
+
+def test_gap_side_not_told_without_the_two_input_transmissibility():
+    import json
+    from pathlib import Path
+
+    from diagnosis.report import render_markdown
+
+    root = Path(__file__).resolve().parents[1] / "results/diagnosis_blind/20261130-local-features-stop65"
+    s = json.loads((root / "measured/case000-summary.json").read_text())
+    # a summary written before gap_side existed says nothing about it
+    assert "Road or vehicle" not in render_markdown(s, {})
+    s = dict(s, verdict_detail=dict(s["verdict_detail"], gap_side=None))
+    assert "Road or vehicle: not told" in render_markdown(s, {})
