@@ -95,3 +95,15 @@ def test_window_edges_lie_on_samples_so_the_simulation_matches_the_window():
         t1 = w.meta["t0"] + w.time.size / sig.fs
         assert round(t1 * sig.fs) - round(w.meta["t0"] * sig.fs) == w.time.size
         assert w.time[0] == sig.time[i0]
+
+
+def test_a_segment_without_a_fit_takes_its_nearest_fitted_neighbours_value():
+    from diagnosis.road_fit import WAVINESS_FILL, nearest_fill
+
+    assert WAVINESS_FILL
+    bounds = [0.0, 1.05, 1.55, 23.3, 30.0]
+    w = nearest_fill([2.0, 2.0, 3.0, 2.6], [False, False, True, True], bounds)
+    # the two short ones take S3's (middle 12.4 s nearer than S4's 26.6 s)
+    assert list(w) == [3.0, 3.0, 3.0, 2.6]
+    assert list(nearest_fill([2.0, 2.0], [False, False], [0, 1, 2])) == [2.0, 2.0]
+    assert list(nearest_fill([2.5, 1.5], [True, True], [0, 1, 2])) == [2.5, 1.5]
