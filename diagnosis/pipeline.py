@@ -967,6 +967,10 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
             "calibration_windows_s": [list(map(float, e)) for e in cal_edges],
             "heldout_windows_s": [list(map(float, e)) for e in held_edges],
             "local_road_features_s": [list(map(float, e)) for e in excluded],
+            # the recorded speed [m/s]: with the road's nmax it says up to which frequency the
+            # road excites the vehicle (verdict.gap_side reads only the bands below)
+            "speed_mps": {"p05": float(np.percentile(sig.speed, 5)), "mean": float(np.mean(sig.speed)),
+                          "max": float(np.max(sig.speed))},
             "noise_std": model.noise, "wheelbase_m": wheelbase, "quick": bool(quick), "seed": int(seed),
             "workers": int(workers), "solver": model.solver, "fold_edge_choice": edge_choice,
             "candidates": [c.name for c in cands],

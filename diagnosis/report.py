@@ -512,19 +512,22 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                                  f"{b['sampling_floor']:.3g})" for b in R["bands_left"]) + ".")
         G = D.get("gap_side") if summary.get("verdict") == "unexplained" else None
         if G:
+            top = G.get("road_input_top_hz")
+            below = ("" if top is None else
+                     f", bands below {top:.3g} Hz, where the road excites the vehicle all along")
             if G["side"] == "road":
                 L.append(f" Road or vehicle: the nominal model's two-input axle-to-body "
                          f"transmissibility agrees with the measurement (0 of {G['tested']} cells "
-                         "flagged), a comparison the road under the wheels does not enter -- so the gap "
-                         "most likely lies in the road model (a spectrum of another shape than ISO 8608's "
-                         "one or two slopes, local features) or in a vehicle difference too small for that "
+                         f"flagged{below}), a comparison the road under the wheels does not enter -- so the gap "
+                         "most likely lies in the road model (a spectrum of another shape than the one-slope "
+                         "ISO 8608 road fitted per segment, local features) or in a vehicle difference too small for that "
                          "comparison to see. On saved blind drives this read 'road' on "
                          f"{GAP_SIDE_MEASURED['road'][0]} of {GAP_SIDE_MEASURED['road'][1]} drives of a "
                          "correct vehicle model.")
             else:
                 L.append(f" Road or vehicle: the nominal model's two-input axle-to-body "
                          f"transmissibility differs from the measurement in {G['flagged']} of "
-                         f"{G['tested']} cells ({', '.join(G['pairs'][:4])}"
+                         f"{G['tested']} cells{below} ({', '.join(G['pairs'][:4])}"
                          + (", ..." if len(G['pairs']) > 4 else "") + "; bands "
                          + ", ".join(f"{b:g}" for b in G["bands_hz"][:6])
                          + (", ..." if len(G["bands_hz"]) > 6 else "") + " Hz), a comparison the road "

@@ -527,3 +527,21 @@ def test_gap_side_not_told_without_the_two_input_transmissibility():
     assert "Road or vehicle" not in render_markdown(s, {})
     s = dict(s, verdict_detail=dict(s["verdict_detail"], gap_side=None))
     assert "Road or vehicle: not told" in render_markdown(s, {})
+
+
+def test_gap_side_reads_only_bands_the_road_excites():
+    """A band above the road's content at the record's speed holds no road input: its
+    transmissibility is not the vehicle's (a noise-free drive of our nominal truck over a profile
+    ending at 2 cycles/m, 9 m/s, flagged the 17.8-22.4 Hz band and read 'vehicle' before)."""
+    from diagnosis.verdict import gap_side, road_input_top_hz
+
+    s = _two_input([False, False, True])
+    for c, band in zip(s["transmissibility_two_input"]["cells"], ([2.8, 3.5], [14.1, 17.8], [17.8, 22.4])):
+        c["band_hz"] = band
+    assert gap_side(s)["side"] == "vehicle"          # an older summary: every band read
+    s["meta"] = {"speed_mps": {"p05": 9.0}, "road_segments": [{"nmax": 5.0}, {"nmax": 2.0}]}
+    assert road_input_top_hz(s) == 18.0
+    g = gap_side(s)
+    assert g["side"] == "road" and g["tested"] == 2 and g["road_input_top_hz"] == 18.0
+    s["meta"]["road_segments"] = [{"nmax": 5.0}]
+    assert gap_side(s)["side"] == "vehicle"          # the road excites 17.8-22.4 Hz at 9 m/s
