@@ -358,6 +358,21 @@ def nominal_record(model: TruckModel, sig: Signals, seed: int = 0) -> dict:
     return simc
 
 
+def set_road_band(model: TruckModel, sig: Signals, cal_edges, nmax, seed: int = 0,
+                  high_band=None) -> dict:
+    """The model's road on another band: ``nmax`` [cycles/m] per segment set (``high_band``
+    default: the segments below ``ROAD_NMAX`` recorded as cut), the levels refitted on the
+    calibration windows, the nominal record run again (lift-off times and noise floor with it);
+    returns that record.  What the band refit and the joint band of :func:`diagnose` do, and the
+    oracle of :func:`heldout_shrink` on the band a diagnosis reported."""
+    model.nmax = nmax
+    model.high_band = high_band if high_band is not None else {
+        "cut": [int(k) for k in np.nonzero(np.asarray(nmax) < ROAD_NMAX)[0]],
+        "rolloff": [], "vetoed": False}
+    model.gq = relevel_road(model, sig, cal_edges, model.gq, seed)
+    return nominal_record(model, sig, seed)
+
+
 def front_rear_or_none(sig, sim, **kw):
     """:func:`diagnosis.compare.front_rear`, or None where the record has no axle
     acceleration of axles 1 and 3 on one side (a logger on one axle only): the report then
@@ -481,12 +496,7 @@ def heldout_shrink(dataset, effects, *, vehicle=None, seed: int = 0, n_seeds: in
     ctx = prepare(sig, vehicle if vehicle is not None else drive.vehicle, seed=seed,
                   n_windows=n_windows)
     if nmax is not None:
-        m = ctx.model
-        m.nmax = np.asarray(nmax, float)
-        m.high_band = {"cut": [int(k) for k in np.nonzero(m.nmax < ROAD_NMAX)[0]],
-                       "rolloff": [], "vetoed": False}
-        m.gq = relevel_road(m, sig, ctx.cal_edges, m.gq, seed)
-        nominal_record(m, sig, seed)
+        set_road_band(ctx.model, sig, ctx.cal_edges, np.asarray(nmax, float), seed)
     sc = _Scorer(Fit(ctx.model), Simulate(ctx.model), ctx.calib, ctx.held, seed, 1, n_seeds,
                  None, None)
     terms = gap_terms(ctx.model, sig) if delay else []
@@ -989,12 +999,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         s = build_summary(**_report_args(ps), meta=make_meta(model, ps, refit_record))
         return {k: s.get(k) for k in ('verdict', 'verdict_confidence', 'verdict_reason', 'ranking')}
 
-    def road_on_band(nmax, high_band):
-        """The model's road on another band: nmax set, levels refitted, the nominal record run
-        again (lift-off times and noise floor with it); returns that record."""
-        model.nmax, model.high_band = nmax, high_band
-        model.gq = relevel_road(model, sig, cal_edges, model.gq, seed)
-        return nominal_record(model, sig, seed)
+    def road_on_band(nmax, high_band=None):
+        return set_road_band(model, sig, cal_edges, nmax, seed, high_band)
 
     try:
         ctx = prepare(sig, veh, seed=seed, n_windows=n_windows, road_fit=road_fit, workers=workers,
@@ -1059,8 +1065,7 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
                             lift_times=model.lift_times, noise=model.noise)
                 kept_simc, kept_timing = simc, dict(timing)
                 new = np.minimum(before, tc['cut'])
-                simc = road_on_band(new, {"cut": [int(k) for k in np.nonzero(new < ROAD_NMAX)[0]],
-                                          "rolloff": [], "vetoed": False})
+                simc = road_on_band(new)
                 progress(f"measured axle spectrum steps down at {tc['cut']:g} cycles/m: the pass "
                          f"again on a road cut there")
                 ps_cut = one_pass(model, simc)
