@@ -729,6 +729,34 @@ def own_signature_record(model: TruckModel, sig: Signals, entry, seed: int, exec
     return rec, _time.perf_counter() - t
 
 
+def hz_signature_record(model: TruckModel, sig: Signals, entries, seed: int, executor=None,
+                        nominal_runs=None):
+    """The ``signature_hz`` record (:func:`diagnosis.hz_fixed.hz_record`) of the low-pass
+    entries among ``entries`` (``(ranking entry or None, its noise-free records on the
+    signature's road phases or None)``: the winner and the close rival), and the seconds
+    taken; ``(None, None)`` where none is a low-pass.  The nominal model's records on the same
+    phases are ``nominal_runs`` where :func:`own_side_record` made them, else run here; every
+    record gets its sensor noise as the transmissibility signature's do."""
+    from diagnosis.hz_fixed import EFFECTS, hz_record
+
+    todo = {e.effect: (e, r) for e, r in entries if e is not None and e.effect in EFFECTS}
+    if not todo:
+        return None, None
+    t = _time.perf_counter()
+    T = sig.time.size / sig.fs
+    seeds = signature_seeds(seed)
+    if nominal_runs is None:
+        nominal_runs = _phase_runs(model, {}, T, seeds, executor)
+
+    def noisy(runs):
+        return [model.add_noise(r, sd) for r, sd in zip(runs, seeds)]
+
+    models = {name: noisy(runs if runs is not None else _phase_runs(model, e.effects, T, seeds, executor))
+              for name, (e, runs) in todo.items()}
+    rec = hz_record(sig.channels, noisy(nominal_runs), models, sig.fs, sig.speed, model.bounds)
+    return rec, _time.perf_counter() - t
+
+
 #: refit the road's high band with the ranking's first effect in the truck (see
 #: :func:`diagnose`, ``settings["band_refit"]``).  Off: it failed its stated test on a fresh
 #: independent-truck set (right names 9/9 -> 8/9; the effect calibrated on the wrong band is too
@@ -773,7 +801,7 @@ def _report_args(ps: dict) -> dict:
     return dict(localization=ps["loc"], transmissibility=ps["tr"], front_rear=ps["fr"], shape=ps["sh"],
                 ranking=ps["ranking"], signature=ps["sig_w"], transmissibility_two_input=ps["tr2"],
                 signature_two_input=ps["sig_w2"], signature_rival=ps["sig_r"],
-                signature_own=ps["sig_own"])
+                signature_own=ps["sig_own"], signature_hz=ps.get("sig_hz"))
 
 
 def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quick: bool = False,
@@ -937,12 +965,19 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
         rival = close_rival(ranking)
         sig_r = None
         if rival is not None:
-            r1, r2, t_r, _ = _model_signature(model, sig, sim, tr, tr2, ranking, seed, ex,
-                                            entry=rival)
+            r1, r2, t_r, runs_r = _model_signature(model, sig, sim, tr, tr2, ranking, seed, ex,
+                                                   entry=rival)
             sig_r = {"effect": rival.effect, "single_input": r1, "two_input": r2}
             timing["signature_rival_s"] = t_r
+        # a low-pass winner or rival: the speed test (fixed in Hz or in cycles/m?)
+        sig_hz, t_hz = hz_signature_record(
+            model, sig, [(ranking.winner, runs_w)] + ([(rival, runs_r)] if rival is not None else []),
+            seed, ex, nominal_runs=nominal_own_runs)
+        if t_hz is not None:
+            timing["signature_hz_s"] = t_hz
         return dict(loc=loc, tr=tr, tr2=tr2, fr=fr, sh=sh, ranking=ranking, sig_w=sig_w,
-                    sig_w2=sig_w2, sig_r=sig_r, sig_own=sig_own, cands=cands, side_rec=side_rec,
+                    sig_w2=sig_w2, sig_r=sig_r, sig_own=sig_own, sig_hz=sig_hz, cands=cands,
+                    side_rec=side_rec,
                     kw=kw, folds=folds, wheelbase=wheelbase)
 
     def make_meta(model, ps, band_refit_record, joint_record=None):

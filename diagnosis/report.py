@@ -65,7 +65,7 @@ def jsonable(obj: Any) -> Any:
 def build_summary(localization=None, *, transmissibility=None, front_rear=None, shape=None,
                   ranking=None, meta: Mapping | None = None, signature=None,
                   transmissibility_two_input=None, signature_two_input=None,
-                  signature_rival=None, signature_own=None) -> dict:
+                  signature_rival=None, signature_own=None, signature_hz=None) -> dict:
     """Machine-readable summary of a diagnosis.
 
     Parameters
@@ -89,6 +89,9 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
     signature_own : dict, optional
         :func:`diagnosis.verdict.own_signature` record of a winner the transmissibility
         cannot test (damper asymmetry): the verdict tests it on this instead.
+    signature_hz : dict, optional
+        :func:`diagnosis.hz_fixed.hz_record` of a low-pass winner or close rival (the speed
+        test: is the roll-off fixed in Hz or in cycles/m).
 
     The verdict is :func:`diagnosis.verdict.decide` on this summary (the ranking's own
     decision is kept under ``ranking_decision``).
@@ -165,6 +168,8 @@ def build_summary(localization=None, *, transmissibility=None, front_rear=None, 
             s["signature_two_input"] = signature_two_input.record()
         if signature_own is not None:
             s["signature_own"] = dict(signature_own)
+        if signature_hz is not None:
+            s["signature_hz"] = dict(signature_hz)
         if signature_rival is not None:
             s["signature_rival"] = {
                 "effect": signature_rival["effect"],
@@ -563,7 +568,19 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                                                        " (it tests this effect on its own signature)"))
                      + ".")
         O = D.get("signature_own")
-        if O and O.get("agrees") is not None:
+        if O and O.get("statistic") == "hz_fixed_slope":
+            L.append(f" Speed test of the low-pass (high-band slope of ln(P_meas/P_nominal) against ln "
+                     f"speed at fixed spatial frequency, axle accelerations; 0 where the roll-off sits "
+                     f"in cycles/m as a road's or a tyre's, negative where it stays in Hz as a "
+                     f"sensor's; sd over road phases {O['sd']:.2g}): measured {O['measured']:+.2f}, "
+                     f"nominal model {O['nominal_mean']:+.2f} (z {O['z_nominal']:+.1f}), with "
+                     f"{O.get('effect', 'the effect')} {O['model_mean']:+.2f}"
+                     + (f"; it {'confirms' if O['agrees'] else 'does not confirm'} the sensor "
+                        "(the verdict uses it instead of the transmissibility, which cancels a "
+                        "low-pass)." if O.get("agrees") is not None else
+                        f"; it {'refutes' if O.get('refutes') else 'does not refute'} the tyre "
+                        "enveloping."))
+        elif O and O.get("agrees") is not None:
             L.append(f" Its own signature, the {own_statistic(O.get('statistic')).name} (mean over the "
                      f"wheel stations; 0 for a linear truck on a Gaussian road; sd over road "
                      f"phases {O['sd']:.2g}): measured {O['measured']:+.3f}, nominal model "
@@ -887,7 +904,8 @@ def _terms_text(settings: Mapping) -> str:
 def write_report(out: str | os.PathLike, *, localization=None, transmissibility=None,
                  front_rear=None, shape=None, ranking=None, meta: Mapping | None = None,
                  force: bool = False, signature=None, transmissibility_two_input=None,
-                 signature_two_input=None, signature_rival=None, signature_own=None) -> Path:
+                 signature_two_input=None, signature_rival=None, signature_own=None,
+                 signature_hz=None) -> Path:
     """Write ``summary.json``, ``figures/*.png`` and ``report.md`` into ``out``.
 
     Parameters
@@ -895,7 +913,7 @@ def write_report(out: str | os.PathLike, *, localization=None, transmissibility=
     out : path
         Run folder; refused if it exists and is not empty unless ``force``.
     localization, transmissibility, front_rear, shape, ranking, meta, signature,
-    transmissibility_two_input, signature_two_input, signature_rival, signature_own
+    transmissibility_two_input, signature_two_input, signature_rival, signature_own, signature_hz
         As for :func:`build_summary`.
     force : bool
         Replace an existing non-empty ``out`` (only after the new one is complete).
@@ -912,7 +930,8 @@ def write_report(out: str | os.PathLike, *, localization=None, transmissibility=
                             shape=shape, ranking=ranking, meta=meta, signature=signature,
                             transmissibility_two_input=transmissibility_two_input,
                             signature_two_input=signature_two_input,
-                            signature_rival=signature_rival, signature_own=signature_own)
+                            signature_rival=signature_rival, signature_own=signature_own,
+                            signature_hz=signature_hz)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=out.parent))
     try:

@@ -392,6 +392,13 @@ OWN_STATISTICS_USED = {
         "stroke-velocity L-skewness",
         "mean over the wheel stations of the L-skewness (Hosking 1990) of the suspension stroke "
         "velocity (suspension displacement band-passed 0.5-15 Hz, differentiated)", 0.003),
+    # stop 66: the speed test of the two low-passes (diagnosis.hz_fixed); floor 0.1, below the
+    # nominal model's sd over 5 road phases on the development drives (0.08-0.45 on ISO roads)
+    "hz_fixed_slope": OwnStatistic(
+        "speed test (high-band slope against speed at fixed spatial frequency)",
+        "pooled within-segment slope, against ln speed, of the record-minus-nominal log power "
+        "of the axle accelerations at fixed spatial frequency (0: a roll-off fixed in cycles/m, "
+        "as a road or a tyre; negative: fixed in Hz, as a sensor low-pass)", 0.1),
 }
 #: the floors by statistic, and the floor of the statistic in use
 OWN_SD_FLOORS = {k: v.sd_floor for k, v in OWN_STATISTICS_USED.items()}
@@ -458,6 +465,70 @@ def own_signature_agrees(record: Mapping, z_nominal: float = OWN_Z_NOMINAL,
     return {"agrees": ok, "z_nominal": z0, "z_model": z1, "sd": sd, "moved": moved,
             "nominal_mean": float(a.mean()), "model_mean": float(b.mean()), "measured": float(m),
             "statistic": record.get("statistic")}
+
+
+#: THE SPEED TEST OF THE LOW-PASSES (stop 66; :mod:`diagnosis.hz_fixed`, summary record
+#: ``signature_hz``).  A sensor low-pass and a spatial low-pass (tyre enveloping, or a road
+#: whose short waves fall off faster than the fitted road's) fit the held-out gap about
+#: equally and no channel ratio tells them apart; speed does: a sensor's roll-off stays at its
+#: cutoff in Hz, a road's or a tyre's moves with speed.  The measurement shows a roll-off fixed
+#: in Hz when its statistic lies at least HZ_Z prediction sd BELOW the nominal model's (one-sided:
+#: a deficit).  A ``sensor`` is then confirmed (replacing the transmissibility, which cancels
+#: it) when its calibrated model moves the statistic HZ_MOVED of the way (between half and twice
+#: the measured departure: the statistic is steep in the cutoff, a few % of calibration error
+#: moves it by more than its road-phase scatter) AND its two-input transmissibility agrees (a
+#: vehicle difference is fixed in Hz too, and shows there); without a deficit a sensor is not
+#: confirmed.  ``tyre_enveloping`` is refuted where the measurement shows the deficit and the
+#: tyre model does not make half of it; otherwise the test says nothing of it (its other tests
+#: stand).  Set on 5 development drives of the saved blind sets (a 43 Hz and a 27 Hz sensor both
+#: lost to tyre enveloping, a tyre enveloping, a no-effect ISO drive and a no-effect drive on the
+#: measured profile, where the nominal scatter is too large for any deficit to show); tested as
+#: stated before its fresh set (results/diagnosis_blind/20261130-speed-test-stop66/).
+HZ_TEST = True
+HZ_Z = 2.0
+HZ_MOVED = (0.5, 2.0)
+
+
+def hz_test(record: Mapping, effect: str, z: float = HZ_Z, moved_range=HZ_MOVED) -> dict:
+    """The speed test of low-pass ``effect`` on a ``signature_hz`` record: the numbers as
+    :func:`own_signature_agrees` gives them (``z_nominal``, ``z_model``, ``sd``, ``moved``, the
+    means) plus ``deficit`` (the measurement's roll-off is fixed in Hz), ``agrees`` (sensor:
+    deficit and moved within ``moved_range``; tyre enveloping: None, the test does not confirm
+    it) and ``refutes`` (tyre enveloping: deficit and moved below ``moved_range[0]``).
+    ``agrees`` None and ``refutes`` False where the record lacks the values."""
+    m = record.get("measured")
+    a = np.asarray([v for v in record.get("nominal") or [] if v is not None and math.isfinite(v)], float)
+    b = np.asarray([v for v in ((record.get("models") or {}).get(effect) or [])
+                    if v is not None and math.isfinite(v)], float)
+    if m is None or not math.isfinite(m) or a.size < 2 or b.size < 2:
+        return {"agrees": None, "refutes": False, "statistic": record.get("statistic")}
+    pooled = math.sqrt((((a - a.mean()) ** 2).sum() + ((b - b.mean()) ** 2).sum())
+                       / (a.size + b.size - 2))
+    sd = max(pooled, own_statistic("hz_fixed_slope").sd_floor) * math.sqrt(1.0 + 2.0 / (a.size + b.size))
+    d0, d1 = float(m) - float(a.mean()), float(m) - float(b.mean())
+    moved = (float(b.mean()) - float(a.mean())) / d0 if d0 != 0.0 else 0.0
+    deficit = bool(d0 / sd <= -z)
+    lo, hi = moved_range
+    out = {"z_nominal": d0 / sd, "z_model": d1 / sd, "sd": sd, "moved": moved,
+           "nominal_mean": float(a.mean()), "model_mean": float(b.mean()), "measured": float(m),
+           "statistic": "hz_fixed_slope", "deficit": deficit, "effect": effect}
+    if effect == "sensor":
+        return dict(out, agrees=bool(deficit and lo <= moved <= hi), refutes=False)
+    return dict(out, agrees=None, refutes=bool(deficit and moved < lo))
+
+
+def hz_text(res: Mapping, effect: str) -> str:
+    """The speed test's numbers in words (reasons and the report)."""
+    if not math.isfinite(res.get("measured", float("nan"))):
+        return "the speed test could not be made"
+    where = ("a roll-off fixed in Hz" if res["deficit"] else "no roll-off fixed in Hz beyond the "
+             "road-phase scatter")
+    return (f"the speed test (high-band slope against speed at fixed spatial frequency; 0 for a "
+            f"road or a tyre, negative for a roll-off fixed in Hz) reads {where}: measured "
+            f"{res['measured']:+.2f}, nominal model {res['nominal_mean']:+.2f} (z "
+            f"{res['z_nominal']:+.1f}, at most {-HZ_Z:g} asked), {effect} {res['model_mean']:+.2f} "
+            f"(it moves the statistic {res['moved']:.0%} of the way, {HZ_MOVED[0]:.0%}-"
+            f"{HZ_MOVED[1]:.0%} asked)")
 
 
 def own_side(measured, nominal, z_nominal: float = OWN_Z_SIDE, statistic: str | None = None) -> int:
@@ -658,6 +729,9 @@ def decide(summary: Mapping, *, tie_break: bool = SIGNATURE_TIE_BREAK, **kw) -> 
     ever one name for another: a drive answered ``none`` or ``unexplained`` stays so.
     """
     d = decide_one(summary, **kw)
+    swapped = _lowpass_swap(summary, d, **kw)
+    if swapped is not None:
+        return swapped
     if d["verdict"] == "unexplained":
         d = with_gap_side(d, summary)
     R = summary.get("signature_rival") or {}
@@ -687,6 +761,42 @@ def decide(summary: Mapping, *, tie_break: bool = SIGNATURE_TIE_BREAK, **kw) -> 
                         f"noise), but {R['effect']}'s {what} axle-to-body transmissibility is "
                         f"nearer the measurement (mean z^2 {dr:.2g} against {dw:.2g}), so "
                         f"{R['effect']} is named -- not 'clear'"))
+
+
+def _lowpass_swap(summary: Mapping, d: Mapping, **kw) -> dict | None:
+    """Where the ranking's winner is tyre enveloping and its close rival a sensor (the two
+    low-passes, within noise of each other on the gap), and the speed test refutes the tyre
+    (a roll-off fixed in Hz it does not make) while confirming the sensor: the sensor is named
+    instead when it passes every test itself (:func:`decide_one` on it), ``ambiguous``.  The
+    other way round (a sensor winner whose roll-off moves with speed) names nothing: a roll-off
+    fixed in cycles/m is the road's as much as a tyre's.  None: no swap."""
+    R = summary.get("signature_rival") or {}
+    rd = summary.get("ranking_decision") or {}
+    rec = summary.get("signature_hz") or {}
+    if not (HZ_TEST and rd.get("verdict") == "tyre_enveloping" and R.get("effect") == "sensor"
+            and (rec.get("models") or {}).get("sensor")):
+        return None
+    if d["verdict"] == "tyre_enveloping":
+        return None
+    w, r = hz_test(rec, "tyre_enveloping"), hz_test(rec, "sensor")
+    if not (w.get("refutes") and r.get("agrees")):
+        return None
+    e = next((x for x in summary.get("ranking") or [] if x.get("effect") == "sensor"), None)
+    if e is None:
+        return None
+    view = dict(summary, signature=R.get("single_input") or {},
+                signature_two_input=R.get("two_input") or {},
+                ranking_decision=dict(rd, verdict="sensor", reason=(
+                    f"sensor shrinks the held-out gap from {e['heldout_gap_before']:.3g} to "
+                    f"{e['heldout_gap_after']:.3g}; tyre_enveloping, ranked first, comes within "
+                    f"noise of it")))
+    d2 = decide_one(view, **kw)
+    if d2["verdict"] != "sensor":
+        return None
+    return dict(d2, identified=False, confidence="ambiguous", lowpass_swap=True,
+                reason=(f"{d2['reason']}; tyre enveloping does not make the roll-off fixed in Hz "
+                        f"the speed test finds (it moves the statistic {w['moved']:.0%} of the "
+                        f"way), so the sensor is named -- not 'clear'"))
 
 
 @dataclass
@@ -742,6 +852,19 @@ def _signature_test(summary: Mapping, win: Mapping, sig: Mapping, sig_method: st
         own_res = own_signature_agrees(rec_own)
         if own_res["agrees"] is not None:
             return _SignatureTest(own_res["agrees"], c0, c1, sig_max, False, own_res)
+    # a low-pass: the speed test (HZ_TEST) confirms a sensor in place of the transmissibility,
+    # which cancels it, and refutes a tyre enveloping that leaves a roll-off fixed in Hz unmade
+    rec_hz = summary.get("signature_hz") or {}
+    if HZ_TEST and ((rec_hz.get("models") or {}).get(win["effect"])):
+        hz = hz_test(rec_hz, win["effect"])
+        if win["effect"] == "sensor" and hz["agrees"] is not None:
+            s2 = summary.get("signature_two_input") or {}
+            c2 = s2.get("chi2_model") if (s2.get("n_cells") or 0) > 0 else None
+            two_ok = c2 is None or c2 <= signature_max
+            return _SignatureTest(bool(hz["agrees"] and two_ok), c0, c1, sig_max, False,
+                                  dict(hz, two_input_chi2=c2, two_input_ok=two_ok))
+        if hz.get("refutes"):
+            return _SignatureTest(False, c0, c1, sig_max, False, hz)
     return _SignatureTest(agrees, c0, c1, sig_max, corroborated, None)
 
 
@@ -920,7 +1043,13 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
         short.append(f"it explains {share:.0%} of the held-out gap above a correct model's "
                      f"(at least {share_min:.0%} asked)" if math.isfinite(share) else
                      "its share of the gap above a correct model's is undefined")
-    if agrees is False and own_res is not None:
+    if agrees is False and own_res is not None and own_res.get("statistic") == "hz_fixed_slope":
+        short.append(hz_text(own_res, win["effect"])
+                     + ("" if own_res.get("two_input_ok", True) else
+                        f"; its two-input transmissibility disagrees with the measurement (mean "
+                        f"z^2 {own_res['two_input_chi2']:.2g}, at most {signature_max:.2g} asked): "
+                        f"a roll-off fixed in Hz with a vehicle difference beside it"))
+    elif agrees is False and own_res is not None:
         short.append(f"its {_what_own(own_res)} does not single it out: measured "
                      f"{own_res['measured']:+.3f}, nominal model {own_res['nominal_mean']:+.3f} "
                      f"(z {own_res['z_nominal']:+.1f}, at least {OWN_Z_NOMINAL:g} asked), "
@@ -974,7 +1103,9 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                + ("" if agrees is not True or remainder or own_res is not None or lowpass else
                   f"; its {what} agrees with the measurement")
                + remainder)
-    if own_res is not None:
+    if own_res is not None and own_res.get("statistic") == "hz_fixed_slope":
+        reason += f"; {hz_text(own_res, win['effect'])}"
+    elif own_res is not None:
         reason += (f"; its {_what_own(own_res)} agrees: measured {own_res['measured']:+.3f}, "
                    f"nominal model {own_res['nominal_mean']:+.3f} (z {own_res['z_nominal']:+.1f}), "
                    f"{win['effect']} {own_res['model_mean']:+.3f} (z {own_res['z_model']:+.1f})")
@@ -1026,7 +1157,13 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"; one fold's calibration lay at an edge of the search range, the other's inside, and "
             f"the whole record fits the inside value better (gap summed over both window sets "
             f"{wr[1 - dropped]:.3g} against {wr[dropped]:.3g}): the value is that fold's -- not 'clear'")
-    if lowpass:
+    if lowpass and own_res is not None and own_res.get("statistic") == "hz_fixed_slope":
+        caveats.append(
+            f"; {win['effect']} is a low-pass of the recorded channels: no channel ratio can confirm "
+            "it, the speed test does (its roll-off stays in Hz as the speed changes, where a road's "
+            "or a tyre's moves with it); check the logger's filter settings before acting on it -- "
+            "not 'clear'")
+    elif lowpass:
         caveats.append(
             f"; {win['effect']} is a low-pass ({'of the recorded channels' if win['effect'] == 'sensor' else 'of the road under the tyres'}): "
             "it acts on the axle and the body alike, so no channel ratio can confirm it (the "
