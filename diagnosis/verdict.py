@@ -151,8 +151,9 @@ VEHICLE_SHARE_MIN = 0.6
 #: measured road profile -- a sensor named on 5 of 8 drives, 2 of them `clear`, and tyre
 #: enveloping `clear` on a drive without it.  So a low-pass name is never `clear` (nor
 #: "identified"): a caveat says why and what to check.  The name itself stays (on synthetic
-#: roads it is right in most cases); the speed dependence that could separate a sensor from the
-#: road (its cutoff fixed in Hz, a road's in cycles/m) is not built.
+#: roads it is right in most cases).  Since stop 66 the speed dependence that separates a sensor
+#: from the road (its cutoff fixed in Hz, a road's in cycles/m) is the sensor's confirmation and
+#: can refute a tyre enveloping (``HZ_TEST``); neither name becomes `clear`.
 LOWPASS_EFFECTS = ("sensor", "tyre_enveloping")
 #: the smallest deviation from "no effect" the verdict names, per effect: effect ->
 #: (parameter, neutral value, smallest relative deviation).  A winner calibrated closer to
