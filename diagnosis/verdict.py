@@ -152,8 +152,8 @@ VEHICLE_SHARE_MIN = 0.6
 #: enveloping `clear` on a drive without it.  So a low-pass name is never `clear` (nor
 #: "identified"): a caveat says why and what to check.  The name itself stays (on synthetic
 #: roads it is right in most cases).  Since stop 66 the speed dependence that separates a sensor
-#: from the road (its cutoff fixed in Hz, a road's in cycles/m) is the sensor's confirmation and
-#: can refute a tyre enveloping (``HZ_TEST``); neither name becomes `clear`.
+#: from the road (its cutoff fixed in Hz, a road's in cycles/m) tests a sensor where it has power
+#: and chooses between a tyre and a sensor that tie (``HZ_RULE``); neither name becomes `clear`.
 LOWPASS_EFFECTS = ("sensor", "tyre_enveloping")
 #: the smallest deviation from "no effect" the verdict names, per effect: effect ->
 #: (parameter, neutral value, smallest relative deviation).  A winner calibrated closer to
@@ -473,48 +473,68 @@ def own_signature_agrees(record: Mapping, z_nominal: float = OWN_Z_NOMINAL,
 #: whose short waves fall off faster than the fitted road's) fit the held-out gap about
 #: equally and no channel ratio tells them apart; speed does: a sensor's roll-off stays at its
 #: cutoff in Hz, a road's or a tyre's moves with speed.  The measurement shows a roll-off fixed
-#: in Hz when its statistic lies at least HZ_Z prediction sd BELOW the nominal model's (one-sided:
-#: a deficit).  A ``sensor`` is then confirmed (replacing the transmissibility, which cancels
-#: it) when its calibrated model moves the statistic HZ_MOVED of the way (between half and twice
-#: the measured departure: the statistic is steep in the cutoff, a few % of calibration error
-#: moves it by more than its road-phase scatter) AND its two-input transmissibility agrees (a
-#: vehicle difference is fixed in Hz too, and shows there); without a deficit a sensor is not
-#: confirmed.  ``tyre_enveloping`` is refuted where the measurement shows the deficit and the
-#: tyre model does not make half of it; otherwise the test says nothing of it (its other tests
-#: stand).  Set on 5 development drives of the saved blind sets (a 43 Hz and a 27 Hz sensor both
-#: lost to tyre enveloping, a tyre enveloping, a no-effect ISO drive and a no-effect drive on the
-#: measured profile, where the nominal scatter is too large for any deficit to show); tested as
-#: stated before its fresh set (results/diagnosis_blind/20261130-speed-test-stop66/).
-HZ_TEST = True
+#: in Hz (a "deficit") when its statistic lies at least HZ_Z prediction sd BELOW the nominal
+#: model's (one-sided); a calibrated sensor "moves" the statistic the fraction HZ_MOVED of the
+#: way (between half and twice the measured departure: the statistic is steep in the cutoff,
+#: a few % of calibration error move it by more than its road-phase scatter).  Two rules:
+#:
+#: ``"replace"`` (the first, stated and tested fresh at stop 66: FAILED its test, see
+#: results/diagnosis_blind/20261130-speed-test-stop66/): a sensor is confirmed only by the speed
+#: test (deficit, moved, and its two-input transmissibility agreeing: a vehicle difference is
+#: fixed in Hz too), never by the transmissibility; a tyre enveloping is refuted where the
+#: deficit is measured and the tyre model makes less than half of it; a tyre winner refuted so,
+#: with a close sensor rival that passes, gives the sensor.  It lost a right tyre enveloping (the
+#: truth's tyre showed a deficit the tyre model does not make) and a right sensor on the measured
+#: road (where the nominal model's own scatter is too large for any deficit to show, and "not
+#: confirmed" became "refuted").
+#:
+#: ``"powered"`` (the second, from that failure): the test decides only where it has power --
+#: the calibrated sensor's own value lies at least HZ_POWER_Z sd from the nominal model's.  There
+#: a sensor is confirmed (deficit, moved, two-input transmissibility agreeing) or refuted (any of
+#: them failing); where it has no power the transmissibility rules stand as before.  A tyre
+#: enveloping is never refuted by it; only where the ranking's winner is a tyre enveloping with
+#: a sensor as its close rival does it choose: the sensor, when its test confirms it and the tyre
+#: model's own value lies at least HZ_Z sd from the measurement (``ambiguous``).
+#: ``"off"``: no speed test.
+HZ_RULES = ("off", "replace", "powered")
+HZ_RULE = "powered"
 HZ_Z = 2.0
 HZ_MOVED = (0.5, 2.0)
+HZ_POWER_Z = 2.0
 
 
-def hz_test(record: Mapping, effect: str, z: float = HZ_Z, moved_range=HZ_MOVED) -> dict:
+def hz_test(record: Mapping, effect: str, z: float = HZ_Z, moved_range=HZ_MOVED,
+            rule: str | None = None) -> dict:
     """The speed test of low-pass ``effect`` on a ``signature_hz`` record: the numbers as
     :func:`own_signature_agrees` gives them (``z_nominal``, ``z_model``, ``sd``, ``moved``, the
-    means) plus ``deficit`` (the measurement's roll-off is fixed in Hz), ``agrees`` (sensor:
-    deficit and moved within ``moved_range``; tyre enveloping: None, the test does not confirm
-    it) and ``refutes`` (tyre enveloping: deficit and moved below ``moved_range[0]``).
+    means) plus ``deficit`` (the measurement's roll-off is fixed in Hz), ``powered`` (the
+    candidate's value lies ``HZ_POWER_Z`` sd or more from the nominal model's), ``agrees``
+    (sensor: deficit and moved within ``moved_range``; under ``rule`` "powered" None where the
+    test has no power; tyre enveloping: None, the test does not confirm it) and ``refutes``
+    (tyre enveloping: deficit and moved below ``moved_range[0]``; what rule "replace" reads).
     ``agrees`` None and ``refutes`` False where the record lacks the values."""
+    rule = HZ_RULE if rule is None else rule
     m = record.get("measured")
     a = np.asarray([v for v in record.get("nominal") or [] if v is not None and math.isfinite(v)], float)
     b = np.asarray([v for v in ((record.get("models") or {}).get(effect) or [])
                     if v is not None and math.isfinite(v)], float)
     if m is None or not math.isfinite(m) or a.size < 2 or b.size < 2:
-        return {"agrees": None, "refutes": False, "statistic": record.get("statistic")}
+        return {"agrees": None, "refutes": False, "powered": False, "statistic": record.get("statistic")}
     pooled = math.sqrt((((a - a.mean()) ** 2).sum() + ((b - b.mean()) ** 2).sum())
                        / (a.size + b.size - 2))
     sd = max(pooled, own_statistic("hz_fixed_slope").sd_floor) * math.sqrt(1.0 + 2.0 / (a.size + b.size))
     d0, d1 = float(m) - float(a.mean()), float(m) - float(b.mean())
     moved = (float(b.mean()) - float(a.mean())) / d0 if d0 != 0.0 else 0.0
     deficit = bool(d0 / sd <= -z)
+    powered = bool(abs(float(b.mean()) - float(a.mean())) / sd >= HZ_POWER_Z)
     lo, hi = moved_range
     out = {"z_nominal": d0 / sd, "z_model": d1 / sd, "sd": sd, "moved": moved,
            "nominal_mean": float(a.mean()), "model_mean": float(b.mean()), "measured": float(m),
-           "statistic": "hz_fixed_slope", "deficit": deficit, "effect": effect}
+           "statistic": "hz_fixed_slope", "deficit": deficit, "powered": powered, "effect": effect,
+           "rule": rule}
     if effect == "sensor":
-        return dict(out, agrees=bool(deficit and lo <= moved <= hi), refutes=False)
+        ok = None if (rule == "powered" and not powered) else bool(deficit and lo <= moved <= hi)
+        return dict(out, agrees=ok, refutes=False)
     return dict(out, agrees=None, refutes=bool(deficit and moved < lo))
 
 
@@ -774,13 +794,14 @@ def _lowpass_swap(summary: Mapping, d: Mapping, **kw) -> dict | None:
     R = summary.get("signature_rival") or {}
     rd = summary.get("ranking_decision") or {}
     rec = summary.get("signature_hz") or {}
-    if not (HZ_TEST and rd.get("verdict") == "tyre_enveloping" and R.get("effect") == "sensor"
-            and (rec.get("models") or {}).get("sensor")):
-        return None
-    if d["verdict"] == "tyre_enveloping":
+    if not (HZ_RULE != "off" and rd.get("verdict") == "tyre_enveloping"
+            and R.get("effect") == "sensor" and (rec.get("models") or {}).get("sensor")):
         return None
     w, r = hz_test(rec, "tyre_enveloping"), hz_test(rec, "sensor")
-    if not (w.get("refutes") and r.get("agrees")):
+    if HZ_RULE == "replace":
+        if d["verdict"] == "tyre_enveloping" or not (w.get("refutes") and r.get("agrees")):
+            return None
+    elif not (r.get("agrees") and w.get("z_model") is not None and abs(w["z_model"]) >= HZ_Z):
         return None
     e = next((x for x in summary.get("ranking") or [] if x.get("effect") == "sensor"), None)
     if e is None:
@@ -796,8 +817,9 @@ def _lowpass_swap(summary: Mapping, d: Mapping, **kw) -> dict | None:
         return None
     return dict(d2, identified=False, confidence="ambiguous", lowpass_swap=True,
                 reason=(f"{d2['reason']}; tyre enveloping does not make the roll-off fixed in Hz "
-                        f"the speed test finds (it moves the statistic {w['moved']:.0%} of the "
-                        f"way), so the sensor is named -- not 'clear'"))
+                        f"the speed test finds (its own value {w['model_mean']:+.2f}, z "
+                        f"{w['z_model']:+.1f} from the measurement), so the sensor is named -- not "
+                        f"'clear'"))
 
 
 @dataclass
@@ -853,10 +875,10 @@ def _signature_test(summary: Mapping, win: Mapping, sig: Mapping, sig_method: st
         own_res = own_signature_agrees(rec_own)
         if own_res["agrees"] is not None:
             return _SignatureTest(own_res["agrees"], c0, c1, sig_max, False, own_res)
-    # a low-pass: the speed test (HZ_TEST) confirms a sensor in place of the transmissibility,
-    # which cancels it, and refutes a tyre enveloping that leaves a roll-off fixed in Hz unmade
+    # a low-pass: where the speed test (HZ_RULE) has power it confirms or refutes a sensor in
+    # place of the transmissibility, which cancels it; rule "replace" also refutes a tyre
     rec_hz = summary.get("signature_hz") or {}
-    if HZ_TEST and ((rec_hz.get("models") or {}).get(win["effect"])):
+    if HZ_RULE != "off" and ((rec_hz.get("models") or {}).get(win["effect"])):
         hz = hz_test(rec_hz, win["effect"])
         if win["effect"] == "sensor" and hz["agrees"] is not None:
             s2 = summary.get("signature_two_input") or {}
@@ -864,7 +886,7 @@ def _signature_test(summary: Mapping, win: Mapping, sig: Mapping, sig_method: st
             two_ok = c2 is None or c2 <= signature_max
             return _SignatureTest(bool(hz["agrees"] and two_ok), c0, c1, sig_max, False,
                                   dict(hz, two_input_chi2=c2, two_input_ok=two_ok))
-        if hz.get("refutes"):
+        if HZ_RULE == "replace" and hz.get("refutes"):
             return _SignatureTest(False, c0, c1, sig_max, False, hz)
     return _SignatureTest(agrees, c0, c1, sig_max, corroborated, None)
 

@@ -95,7 +95,10 @@ def _record(measured, nominal, sensor=None, tyre=None):
 NOM = [0.1, -0.2, 0.15, -0.05, 0.0]
 
 
-def test_hz_test_confirms_a_sensor_only_on_a_deficit_it_makes():
+def test_hz_test_confirms_a_sensor_only_on_a_deficit_it_makes(monkeypatch):
+    from diagnosis import verdict
+
+    monkeypatch.setattr(verdict, "HZ_RULE", "powered")
     rec = _record(-1.5, NOM, sensor=[-1.6, -1.4, -1.8, -1.5, -1.3], tyre=[0.1, 0.0, -0.1, 0.2, 0.0])
     assert hz_test(rec, "sensor")["agrees"] is True
     assert hz_test(rec, "tyre_enveloping")["refutes"] is True
@@ -108,6 +111,17 @@ def test_hz_test_confirms_a_sensor_only_on_a_deficit_it_makes():
     assert hz_test(rec2, "sensor")["agrees"] is False
     # values missing: no answer
     assert hz_test(_record(None, NOM, sensor=[-1.0, -1.0]), "sensor")["agrees"] is None
+
+
+def test_without_power_the_speed_test_says_nothing():
+    """Rule "powered": where the sensor's own value lies within HZ_POWER_Z sd of the nominal
+    model's (a scatter of 4.7 as on the measured road profile, development drive 527113), the
+    test neither confirms nor refutes; rule "replace" (stop 66's first, failed) refuted there."""
+    wide = [1.1, 1.0, 5.8, -4.8, -3.0]
+    rec = _record(-0.9, wide, sensor=[-6.7, 1.7, 1.8, -7.1, -4.7])
+    res = hz_test(rec, "sensor", rule="powered")
+    assert res["powered"] is False and res["agrees"] is None
+    assert hz_test(rec, "sensor", rule="replace")["agrees"] is False
 
 
 def _summary(hz, two_input_sensor=0.7):
@@ -133,8 +147,11 @@ def _summary(hz, two_input_sensor=0.7):
         "signature_hz": hz, "transmissibility": [{}]}
 
 
-def test_the_speed_test_swaps_a_tyre_for_the_sensor_it_cannot_be():
+def test_the_speed_test_swaps_a_tyre_for_the_sensor_it_cannot_be(monkeypatch):
+    from diagnosis import verdict
     from diagnosis.verdict import decide
+
+    monkeypatch.setattr(verdict, "HZ_RULE", "powered")
 
     hz = _record(-1.5, NOM, sensor=[-1.6, -1.4, -1.8, -1.5, -1.3], tyre=[0.1, 0.0, -0.1, 0.2, 0.0])
     d = decide(_summary(hz))
@@ -147,3 +164,16 @@ def test_the_speed_test_swaps_a_tyre_for_the_sensor_it_cannot_be():
     hz0 = _record(0.0, NOM, sensor=[-1.6, -1.4, -1.8, -1.5, -1.3], tyre=[0.1, 0.0, -0.1, 0.2, 0.0])
     assert _lowpass_swap(_summary(hz0), {"verdict": "unexplained"}) is None
     assert decide(_summary(hz0))["verdict"] in ("tyre_enveloping", "unexplained")
+    # the tyre model making the measured value itself: no swap
+    hz1 = _record(-1.5, NOM, sensor=[-1.6, -1.4, -1.8, -1.5, -1.3], tyre=[-1.4, -1.5, -1.6, -1.5, -1.3])
+    assert _lowpass_swap(_summary(hz1), {"verdict": "unexplained"}) is None
+
+
+def test_rule_off_is_the_verdict_without_the_record(monkeypatch):
+    from diagnosis import verdict
+
+    hz = _record(-1.5, NOM, sensor=[-1.6, -1.4, -1.8, -1.5, -1.3], tyre=[0.1, 0.0, -0.1, 0.2, 0.0])
+    monkeypatch.setattr(verdict, "HZ_RULE", "off")
+    s = _summary(hz)
+    without = {k: v for k, v in s.items() if k != "signature_hz"}
+    assert verdict.decide(s)["verdict"] == verdict.decide(without)["verdict"] != "sensor"

@@ -1,12 +1,15 @@
-"""Old (no speed test) against new verdicts on the same drives: python compare.py DIR [DIR ...]
+"""Old (no speed test) against new verdicts on the same drives:
+python compare.py [--rule replace|powered] DIR [DIR ...]
 
 Each DIR holds blind.json and caseNNN-summary.json (a committed set) or caseNNN-run/summary.json
 (a bench work folder).  "old" re-decides each summary with its `signature_hz` record removed; "new"
-is the verdict as written (the code with the speed test)."""
+re-decides it with the speed test under --rule (diagnosis.verdict.HZ_RULES; default the code's
+HZ_RULE; the fresh test of this folder ran "replace")."""
 import json
 import sys
 from pathlib import Path
 
+from diagnosis import verdict
 from diagnosis.verdict import decide
 
 
@@ -64,4 +67,9 @@ def main(dirs):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    args = sys.argv[1:]
+    if args and args[0] == "--rule":
+        verdict.HZ_RULE = args[1]
+        args = args[2:]
+    print(f"rule: {verdict.HZ_RULE}")
+    main(args)
