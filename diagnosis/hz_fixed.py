@@ -97,6 +97,12 @@ def noise_floor(f, P, fs: float) -> float:
     return float(np.median(P[:, top].mean(axis=1)))
 
 
+def _windows(channels: Mapping[str, np.ndarray], speed, fs: float, names: Sequence[str]):
+    """A record's window PSDs, speeds, centre times and noise floor: what :func:`_slope` reads."""
+    f, P, v, t = window_log_psd(channels, speed, fs, names)
+    return f, P, v, t, noise_floor(f, P, fs)
+
+
 def speed_slope(rec: Mapping[str, np.ndarray], ref: Mapping[str, np.ndarray], fs: float, speed,
                 bounds, names: Sequence[str] | None = None, f_lo: float = F_LO,
                 f_hi: float = F_HI, snr: float = SNR, n_bins: int = N_BINS) -> tuple[float, int]:
@@ -104,14 +110,20 @@ def speed_slope(rec: Mapping[str, np.ndarray], ref: Mapping[str, np.ndarray], fs
     segment edges in record time [s]).  Returns ``(slope, cells)``; slope NaN where no segment
     holds ``MIN_WINDOWS`` windows with usable cells or the speed does not vary."""
     names = list(names) if names is not None else [c for c in rec if c.startswith(CHANNEL_PREFIX)]
+    if not names:
+        return float("nan"), 0
+    return _slope(_windows(rec, speed, fs, names), _windows(ref, speed, fs, names), fs, bounds,
+                  f_lo, f_hi, snr, n_bins)
+
+
+def _slope(wa, wb, fs: float, bounds, f_lo: float = F_LO, f_hi: float = F_HI, snr: float = SNR,
+           n_bins: int = N_BINS) -> tuple[float, int]:
+    """:func:`speed_slope` on two records' :func:`_windows`."""
+    f, A, v, t, na = wa
+    B, nb = wb[1], wb[4]
     f_hi = min(f_hi, 0.35 * fs)
-    if not names or f_hi <= f_lo:
+    if f_hi <= f_lo or A.shape[0] < MIN_WINDOWS or np.ptp(v) <= 0:
         return float("nan"), 0
-    f, A, v, t = window_log_psd(rec, speed, fs, names)
-    _, B, _, _ = window_log_psd(ref, speed, fs, names)
-    if A.shape[0] < MIN_WINDOWS or np.ptp(v) <= 0:
-        return float("nan"), 0
-    na, nb = noise_floor(f, A, fs), noise_floor(f, B, fs)
     pa, pb = A - na, B - nb
     ok = (pa > snr * na) & (pb > snr * nb) & (pa > 0) & (pb > 0)
     D = np.full(A.shape, np.nan)
@@ -163,12 +175,14 @@ def hz_record(measured: Mapping[str, np.ndarray], nominal: Sequence[Mapping[str,
     names = [c for c in measured if c.startswith(CHANNEL_PREFIX)]
     if not names or len(nominal) < 2:
         return None
+    win = lambda rec: _windows(rec, speed, fs, names)  # noqa: E731 -- each record's PSDs once
+    refs = [win(r) for r in nominal]
 
-    def stat(rec, skip=None):
-        return _mean_finite(speed_slope(rec, ref, fs, speed, bounds, names)[0]
-                            for j, ref in enumerate(nominal) if j != skip)
+    def stat(w, skip=None):
+        return _mean_finite(_slope(w, ref, fs, bounds)[0] for j, ref in enumerate(refs) if j != skip)
 
     return {"statistic": STATISTIC, "measure": MEASURE, "band_hz": [F_LO, min(F_HI, 0.35 * fs)],
-            "measured": stat(measured),
-            "nominal": [stat(r, skip=i) for i, r in enumerate(nominal)],
-            "models": {e: [stat(r, skip=i) for i, r in enumerate(recs)] for e, recs in models.items()}}
+            "measured": stat(win(measured)),
+            "nominal": [stat(w, skip=i) for i, w in enumerate(refs)],
+            "models": {e: [stat(win(r), skip=i) for i, r in enumerate(recs)]
+                       for e, recs in models.items()}}

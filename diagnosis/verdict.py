@@ -455,17 +455,25 @@ def own_signature_agrees(record: Mapping, z_nominal: float = OWN_Z_NOMINAL,
     b = np.asarray([v for v in record.get("model") or [] if v is not None], float)
     if m is None or a.size < 2 or b.size < 2:
         return {"agrees": None}
+    n = _own_numbers(m, a, b, own_statistic(record.get("statistic")).sd_floor)
+    ok = bool(abs(n["z_nominal"]) >= z_nominal and abs(n["z_model"]) <= z_model
+              and n["moved"] >= share)
+    return {"agrees": ok, **n, "statistic": record.get("statistic")}
+
+
+def _own_numbers(m: float, a: np.ndarray, b: np.ndarray, floor: float) -> dict:
+    """The measured value ``m`` against the nominal (``a``) and candidate (``b``) models' values
+    over the same road phases: their pooled sd (at least ``floor``) as the prediction sd of one
+    measurement against a model's mean, ``s sqrt(1 + 2/(na + nb))``; ``z_nominal``, ``z_model``
+    and ``moved`` (the fraction of the way from the nominal's mean to ``m`` the candidate's
+    mean lies).  What :func:`own_signature_agrees` and :func:`hz_test` both judge."""
     pooled = math.sqrt((((a - a.mean()) ** 2).sum() + ((b - b.mean()) ** 2).sum())
                        / (a.size + b.size - 2))
-    floor = own_statistic(record.get("statistic")).sd_floor
     sd = max(pooled, floor) * math.sqrt(1.0 + 2.0 / (a.size + b.size))
     d0, d1 = float(m) - float(a.mean()), float(m) - float(b.mean())
-    z0, z1 = d0 / sd, d1 / sd
     moved = (float(b.mean()) - float(a.mean())) / d0 if d0 != 0.0 else 0.0
-    ok = bool(abs(z0) >= z_nominal and abs(z1) <= z_model and moved >= share)
-    return {"agrees": ok, "z_nominal": z0, "z_model": z1, "sd": sd, "moved": moved,
-            "nominal_mean": float(a.mean()), "model_mean": float(b.mean()), "measured": float(m),
-            "statistic": record.get("statistic")}
+    return {"z_nominal": d0 / sd, "z_model": d1 / sd, "sd": sd, "moved": moved,
+            "nominal_mean": float(a.mean()), "model_mean": float(b.mean()), "measured": float(m)}
 
 
 #: THE SPEED TEST OF THE LOW-PASSES (stop 66; :mod:`diagnosis.hz_fixed`, summary record
@@ -522,18 +530,12 @@ def hz_test(record: Mapping, effect: str, z: float = HZ_Z, moved_range=HZ_MOVED,
                     if v is not None and math.isfinite(v)], float)
     if m is None or not math.isfinite(m) or a.size < 2 or b.size < 2:
         return {"agrees": None, "refutes": False, "powered": False, "statistic": record.get("statistic")}
-    pooled = math.sqrt((((a - a.mean()) ** 2).sum() + ((b - b.mean()) ** 2).sum())
-                       / (a.size + b.size - 2))
-    sd = max(pooled, own_statistic("hz_fixed_slope").sd_floor) * math.sqrt(1.0 + 2.0 / (a.size + b.size))
-    d0, d1 = float(m) - float(a.mean()), float(m) - float(b.mean())
-    moved = (float(b.mean()) - float(a.mean())) / d0 if d0 != 0.0 else 0.0
-    deficit = bool(d0 / sd <= -z)
-    powered = bool(abs(float(b.mean()) - float(a.mean())) / sd >= HZ_POWER_Z)
-    lo, hi = moved_range
-    out = {"z_nominal": d0 / sd, "z_model": d1 / sd, "sd": sd, "moved": moved,
-           "nominal_mean": float(a.mean()), "model_mean": float(b.mean()), "measured": float(m),
-           "statistic": "hz_fixed_slope", "deficit": deficit, "powered": powered, "effect": effect,
-           "rule": rule}
+    n = _own_numbers(m, a, b, own_statistic("hz_fixed_slope").sd_floor)
+    deficit = bool(n["z_nominal"] <= -z)
+    powered = bool(abs(n["model_mean"] - n["nominal_mean"]) / n["sd"] >= HZ_POWER_Z)
+    moved, lo, hi = n["moved"], *moved_range
+    out = {**n, "statistic": "hz_fixed_slope", "deficit": deficit, "powered": powered,
+           "effect": effect, "rule": rule}
     if effect == "sensor":
         ok = None if (rule == "powered" and not powered) else bool(deficit and lo <= moved <= hi)
         return dict(out, agrees=ok, refutes=False)
@@ -770,10 +772,7 @@ def decide(summary: Mapping, *, tie_break: bool = SIGNATURE_TIE_BREAK, **kw) -> 
     if dw is None or dr is None or not dr <= TIE_RATIO * dw:
         return dict(d, tie_break={"rival": R["effect"], "method": method, "winner_chi2": dw,
                                   "rival_chi2": dr, "swapped": False})
-    view = dict(summary, signature=R.get("single_input") or {},
-                signature_two_input=R.get("two_input") or {},
-                ranking_decision=dict(rd, verdict=R["effect"]))
-    d2 = decide_one(view, **kw)
+    d2 = decide_one(_rival_view(summary, R, verdict=R["effect"]), **kw)
     info = {"rival": R["effect"], "method": method, "winner_chi2": dw, "rival_chi2": dr,
             "swapped": d2["verdict"] == R["effect"]}
     if not info["swapped"]:
@@ -784,6 +783,15 @@ def decide(summary: Mapping, *, tie_break: bool = SIGNATURE_TIE_BREAK, **kw) -> 
                         f"noise), but {R['effect']}'s {what} axle-to-body transmissibility is "
                         f"nearer the measurement (mean z^2 {dr:.2g} against {dw:.2g}), so "
                         f"{R['effect']} is named -- not 'clear'"))
+
+
+def _rival_view(summary: Mapping, rival: Mapping, **decision) -> dict:
+    """The summary as :func:`decide_one` would read it had the ranking chosen the close rival
+    (``signature_rival``): its signatures in the winner's place, the ranking's decision updated
+    with ``decision`` (``verdict``, and ``reason`` where given)."""
+    return dict(summary, signature=rival.get("single_input") or {},
+                signature_two_input=rival.get("two_input") or {},
+                ranking_decision=dict(summary.get("ranking_decision") or {}, **decision))
 
 
 def _lowpass_swap(summary: Mapping, d: Mapping, **kw) -> dict | None:
@@ -808,13 +816,10 @@ def _lowpass_swap(summary: Mapping, d: Mapping, **kw) -> dict | None:
     e = next((x for x in summary.get("ranking") or [] if x.get("effect") == "sensor"), None)
     if e is None:
         return None
-    view = dict(summary, signature=R.get("single_input") or {},
-                signature_two_input=R.get("two_input") or {},
-                ranking_decision=dict(rd, verdict="sensor", reason=(
-                    f"sensor shrinks the held-out gap from {e['heldout_gap_before']:.3g} to "
-                    f"{e['heldout_gap_after']:.3g}; tyre_enveloping, ranked first, comes within "
-                    f"noise of it")))
-    d2 = decide_one(view, **kw)
+    d2 = decide_one(_rival_view(summary, R, verdict="sensor", reason=(
+        f"sensor shrinks the held-out gap from {e['heldout_gap_before']:.3g} to "
+        f"{e['heldout_gap_after']:.3g}; tyre_enveloping, ranked first, comes within noise of it")),
+        **kw)
     if d2["verdict"] != "sensor":
         return None
     return dict(d2, identified=False, confidence="ambiguous", lowpass_swap=True,
