@@ -580,6 +580,13 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                         "low-pass)." if O.get("agrees") is not None else
                         f"; it {'refutes' if O.get('refutes') else 'does not refute'} the tyre "
                         "enveloping."))
+        elif O and O.get("statistic") == "front_rear_delay":
+            L.append(f" Front-to-rear delay test of the speed error (measured delay over the nominal "
+                     f"model's; a speed signal off by a factor scales it by that factor): "
+                     f"{O['ratio']:.4f} [{O['ci'][0]:.4f}, {O['ci'][1]:.4f}] over {O['n_pairs']} "
+                     f"pair(s), calibrated factor {O['factor']:.4f}; it "
+                     + ("confirms" if O["agrees"] else "refutes")
+                     + " the speed error; the verdict uses it instead of the transmissibility.")
         elif O and O.get("agrees") is not None:
             L.append(f" Its own signature, the {own_statistic(O.get('statistic')).name} (mean over the "
                      f"wheel stations; 0 for a linear truck on a Gaussian road; sd over road "
