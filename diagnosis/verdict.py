@@ -576,8 +576,8 @@ def delay_text(res: Mapping) -> str:
     head = (f"the front-to-rear delay measured over the nominal model's (what a speed error "
             f"scales; {res['n_pairs']} front/rear pair(s)) is {r:.4f} [{lo:.4f}, {hi:.4f}]")
     if res["why"] == "confirms":
-        return (f"{head}: a speed error of {r - 1:+.1%}, which the calibrated factor {f:.4f} "
-                f"matches")
+        return (f"{head}: the recorded speed reads {r - 1:+.1%} off the true one, and the "
+                f"calibrated factor {f:.4f} matches it")
     if res["why"] == "no_speed_error":
         return (f"{head}, within {DELAY_MIN:.1%} of 1: the delay shows no speed error a cause "
                 f"could be made of, whatever the calibrated factor ({f:.4f}) takes up")
