@@ -497,3 +497,24 @@ def test_an_overshoot_within_noise_agrees_and_a_short_move_does_not():
 def test_a_short_move_is_said_in_the_reason():
     d = decide(_summary(own=own_signature("damper_asymmetry", 0.015, [0.0] * 5, [0.006] * 5)))
     assert "moves the statistic 40% of the way" in d["reason"] and "at least 50% asked" in d["reason"]
+
+
+def test_own_signature_at_the_one_sided_five_percent_level_names_but_never_clearly():
+    """Saved blind drive (seed 607 nominal case 15: damper asymmetry 2.31, ranked first with 98 %
+    of the gap): its L-skewness departs from the nominal model's by 1.81 sd, which the one-sided
+    5 % level (1.645) accepts and the old 2.0 did not; the name is never 'clear' below
+    OWN_Z_CLEAR."""
+    import json
+    from pathlib import Path
+
+    from diagnosis import verdict
+    from diagnosis.verdict import OWN_Z_CLEAR
+
+    s = json.loads((Path(__file__).resolve().parents[1] / "results/diagnosis_blind/"
+                    "20261130-speed-test-stop66/nominal/case015-summary.json").read_text())
+    d = decide(s)
+    assert d["verdict"] == "damper_asymmetry" and d["confidence"] == "ambiguous", d["reason"]
+    z = d["signature_own"]["z_nominal"]
+    assert OWN_Z_NOMINAL <= abs(z) < OWN_Z_CLEAR
+    assert "1.8 sd only" in d["reason"] and "asked for 'clear'" in d["reason"]
+    assert verdict.own_signature_agrees(s["signature_own"], z_nominal=2.0)["agrees"] is False
