@@ -94,3 +94,25 @@ def test_saved_independent_truck_drive_without_speed_error_is_not_named():
     assert d["verdict"] == "unexplained"
     assert d["signature_own"]["why"] == "no_speed_error"
     assert "no speed error" in d["reason"]
+
+
+def test_paired_re_decision_of_a_saved_set(monkeypatch):
+    """diagnosis.redecide.paired on the committed seed-607 nominal set: with and without the delay
+    rule only the missed speed error changes (case 18, named; case 7 was named clear already), none goes from
+    right to wrong; deciding twice with one rule changes nothing."""
+    from diagnosis.redecide import paired
+
+    def rule(on):
+        def run(s):
+            monkeypatch.setattr(verdict, "DELAY_RULE", on)
+            return decide(s)
+        return run
+
+    lines = []
+    folder = ROOT / "20261130-speed-test-stop66/nominal"
+    t = paired([folder], rule(False), rule(True), "speed_scale", out=lines.append)
+    assert t["drives"] == 22 and t["focus"] == [1, 2, 2] and t["right_to_wrong"] == 0
+    assert any("case 18 truth speed_scale" in x and "-> speed_scale" in x for x in lines)
+    assert t["changed"] == 1
+    same = paired([folder], rule(True), rule(True), "speed_scale", out=lambda x: None)
+    assert same["changed"] == 0 and same["effect"][0] == same["effect"][1]

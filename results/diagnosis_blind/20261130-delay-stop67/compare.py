@@ -5,80 +5,22 @@ Each DIR holds blind.json and caseNNN-summary.json (a committed set) or caseNNN-
 (a bench work folder).  Every summary is re-decided twice with the code's verdict rules:
 "old" with diagnosis.verdict.DELAY_RULE False, "new" with it True (the front-to-rear delay test
 of a speed_scale winner, stop 67).  The delay test needs no record beyond `front_rear`, which
-every summary since 2026-11-21 carries.  Prints each changed drive and a line per folder."""
-import json
+every summary since 2026-11-21 carries."""
 import sys
-from pathlib import Path
 
 from diagnosis import verdict
-from diagnosis.verdict import decide
+from diagnosis.redecide import paired
 
 
-def summary_of(d: Path, case: int):
-    for p in (d / f"case{case:03d}-summary.json", d / f"case{case:03d}-run" / "summary.json"):
-        if p.is_file():
-            return json.load(open(p))
-    return None
-
-
-def both(s):
-    verdict.DELAY_RULE = False
-    old = decide(s)
-    verdict.DELAY_RULE = True
-    new = decide(s)
-    return old, new
-
-
-def right(dd, truth):
-    return dd["verdict"] == truth if truth != "none" else dd["verdict"] in ("none", "unexplained")
-
-
-def main(dirs):
-    total = {"speed": [0, 0, 0], "effect": [0, 0, 0], "null": [0, 0, 0], "wrong": [0, 0],
-             "clear_wrong": [0, 0], "changed": 0, "drives": 0}
-    for d in map(Path, dirs):
-        b = json.load(open(d / "blind.json"))
-        c = {k: (list(v) if isinstance(v, list) else 0) for k, v in total.items()}
-        c = {"speed": [0, 0, 0], "effect": [0, 0, 0], "null": [0, 0, 0], "wrong": [0, 0],
-             "clear_wrong": [0, 0], "changed": 0, "drives": 0}
-        for r in b["results"]:
-            s = summary_of(d, r["case"])
-            if s is None:
-                continue
-            truth = r["effect"]
-            old, new = both(s)
-            c["drives"] += 1
-            key = "null" if truth == "none" else "effect"
-            for i, dd in ((0, old), (1, new)):
-                c[key][i] += right(dd, truth)
-                if truth == "speed_scale":
-                    c["speed"][i] += right(dd, truth)
-                wrong = dd["verdict"] not in ("none", "unexplained") and dd["verdict"] != truth
-                c["wrong"][i] += wrong
-                c["clear_wrong"][i] += wrong and dd["confidence"] == "clear"
-            c[key][2] += 1
-            c["speed"][2] += truth == "speed_scale"
-            if (old["verdict"], old["confidence"]) != (new["verdict"], new["confidence"]):
-                c["changed"] += 1
-                print(f"  {d} case {r['case']} truth {truth} {r.get('value')}: {old['verdict']} "
-                      f"({old['confidence']}) -> {new['verdict']} ({new['confidence']})")
-        print(f"{d}: drives {c['drives']}; library effects right {c['effect'][0]} -> {c['effect'][1]} "
-              f"of {c['effect'][2]} (speed_scale {c['speed'][0]} -> {c['speed'][1]} of {c['speed'][2]}); "
-              f"no effect none/unexplained {c['null'][0]} -> {c['null'][1]} of {c['null'][2]}; wrong "
-              f"names {c['wrong'][0]} -> {c['wrong'][1]} (clear {c['clear_wrong'][0]} -> "
-              f"{c['clear_wrong'][1]}); changed {c['changed']}")
-        for k in total:
-            if isinstance(total[k], list):
-                total[k] = [a + b for a, b in zip(total[k], c[k])]
-            else:
-                total[k] += c[k]
-    print(f"ALL: drives {total['drives']}; library effects right {total['effect'][0]} -> "
-          f"{total['effect'][1]} of {total['effect'][2]} (speed_scale {total['speed'][0]} -> "
-          f"{total['speed'][1]} of {total['speed'][2]}); no effect {total['null'][0]} -> "
-          f"{total['null'][1]} of {total['null'][2]}; wrong names {total['wrong'][0]} -> "
-          f"{total['wrong'][1]} (clear {total['clear_wrong'][0]} -> {total['clear_wrong'][1]}); "
-          f"changed {total['changed']}")
+def with_rule(on):
+    def run(s):
+        keep, verdict.DELAY_RULE = verdict.DELAY_RULE, on
+        try:
+            return verdict.decide(s)
+        finally:
+            verdict.DELAY_RULE = keep
+    return run
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    paired(sys.argv[1:], with_rule(False), with_rule(True), "speed_scale")
