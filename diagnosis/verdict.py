@@ -47,7 +47,9 @@ Vocabulary
        gap with a rival is broken by the transmissibility (:func:`decide`,
        ``SIGNATURE_TIE_BREAK``).  An effect listed in ``OWN_SIGNATURE`` (damper asymmetry) is
        tested on its own road-independent signature instead of the transmissibility it barely
-       moves (:func:`own_signature_agrees`: the stroke-velocity L-skewness), both ways.  ``identified``
+       moves (:func:`own_signature_agrees`: the stroke-velocity L-skewness), both ways; a
+       speed_scale winner on the front-to-rear delay, which a speed error scales
+       (:func:`delay_test`, ``DELAY_RULE``), both ways, where its intervals are narrow.  ``identified``
     (in the result) is True when the named effect's identity and value are not in doubt
     (no close rival, no range edge) even if a remainder keeps it from "clear"; the closed
     loop (``diagnosis.closed_loop``) corrects with every named effect whose value is not at a
