@@ -588,7 +588,8 @@ def delay_text(res: Mapping) -> str:
             f"scales; {res['n_pairs']} front/rear pair(s)) is {r:.4f} [{lo:.4f}, {hi:.4f}]")
     if res["why"] == "confirms":
         return (f"{head}: the recorded speed reads {r - 1:+.1%} off the true one, and the "
-                f"calibrated factor {f:.4f} matches it")
+                f"calibrated factor {f:.4f} matches it (check the speed signal: a wheel-speed "
+                f"signal follows the rolling radius, which load, pressure and wear move)")
     if res["why"] == "no_speed_error":
         return (f"{head}, within {DELAY_MIN:.1%} of 1: the delay shows no speed error a cause "
                 f"could be made of, whatever the calibrated factor ({f:.4f}) takes up")
