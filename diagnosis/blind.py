@@ -34,6 +34,7 @@ import json
 import math
 import time as _time
 from pathlib import Path
+from typing import Callable, Mapping
 
 import numpy as np
 
@@ -331,7 +332,7 @@ def two_rule_counts(results: list[dict], key: str, which: str = "final") -> dict
     vals = [x[3] for x in lib if x[1] and x[3] is not None]
     return {"named": sum(x[1] for x in lib), "library": len(lib),
             "no_effect_right": sum(x[1] for x in nul), "no_effect": len(nul),
-            "wrong": sum(1 for r, x in g if x[0] not in ("none", "unexplained") and x[0] != r["effect"]),
+            "wrong": sum(1 for r, x in g if wrong_name(r, x[0])),
             "clear_wrong": sum(x[2] for _, x in g),
             "within_1p5": sum(1 for v in vals if 1 / 1.5 <= v <= 1.5), "valued": len(vals)}
 
@@ -361,8 +362,13 @@ def judge(case: dict, verdict: str, confidence) -> dict:
         correct = verdict in NO_EFFECT_ANSWERS
     else:
         correct = verdict == case["effect"]
-    wrong_name = verdict not in NO_EFFECT_ANSWERS and verdict != case["effect"]
-    return {"correct": bool(correct), "confident_wrong": bool(wrong_name and confidence == "clear")}
+    wrong = wrong_name(case, verdict)
+    return {"correct": bool(correct), "confident_wrong": bool(wrong and confidence == "clear")}
+
+
+def wrong_name(case: dict, verdict: str) -> bool:
+    """The verdict names a library effect that is not the truth's."""
+    return verdict not in NO_EFFECT_ANSWERS and verdict != case["effect"]
 
 
 def param_ratio(case: dict, entry) -> float | None:
@@ -379,27 +385,82 @@ def param_ratio(case: dict, entry) -> float | None:
     return got / true if true else None
 
 
+def saved_cases(root):
+    """Each case of ``root/blind.json`` with its saved summary, ``(case result, summary)``: the
+    summary where the run recorded it, else ``caseNNN-run/summary.json`` (a bench work folder),
+    else ``caseNNN-summary.json`` (an archived results folder); cases without one are skipped."""
+    root = Path(root)
+    for r in json.loads((root / "blind.json").read_text())["results"]:
+        tries = [Path(r["summary"])] if r.get("summary") else []
+        tries += [root / f"case{r['case']:03d}-run" / "summary.json",
+                  root / f"case{r['case']:03d}-summary.json"]
+        p = next((t for t in tries if t.is_file()), None)
+        if p is not None:
+            yield r, json.loads(p.read_text())
+
+
 def rescore(root, **thresholds) -> dict:
     """Re-decide every case of ``root/blind.json`` from its saved summary with other
     thresholds of :func:`diagnosis.verdict.decide`; returns ``{"results", "score"}``."""
     from diagnosis.verdict import decide
 
-    root = Path(root)
     results = []
-    for r in json.loads((root / "blind.json").read_text())["results"]:
-        tries = [Path(r["summary"])] if r.get("summary") else []
-        tries += [root / f"case{r['case']:03d}-run" / "summary.json",
-                  root / f"case{r['case']:03d}-summary.json"]     # an archived results folder
-        p = next((t for t in tries if t.is_file()), None)
-        if p is None:
-            continue
-        summ = json.loads(p.read_text())
+    for r, summ in saved_cases(root):
         d = decide(summ, **thresholds)
         entry = next((e for e in summ.get("ranking", []) if e["effect"] == d["verdict"]), None)
         results.append(dict(r, verdict=d["verdict"], confidence=d["confidence"],
                             **judge(r, d["verdict"], d["confidence"]),
                             param_ratio=param_ratio(r, entry)))
     return {"results": results, "score": score(results)}
+
+
+def _paired_blank() -> dict:
+    return {"focus": [0, 0, 0], "effect": [0, 0, 0], "null": [0, 0, 0], "wrong": [0, 0],
+            "clear_wrong": [0, 0], "right_to_wrong": 0, "changed": 0, "drives": 0}
+
+
+def _paired_line(name: str, c: Mapping, focus: str) -> str:
+    return (f"{name}: drives {c['drives']}; library effects right {c['effect'][0]} -> {c['effect'][1]} "
+            f"of {c['effect'][2]} ({focus} {c['focus'][0]} -> {c['focus'][1]} of {c['focus'][2]}); "
+            f"no effect none/unexplained {c['null'][0]} -> {c['null'][1]} of {c['null'][2]}; wrong "
+            f"names {c['wrong'][0]} -> {c['wrong'][1]} (clear {c['clear_wrong'][0]} -> "
+            f"{c['clear_wrong'][1]}); right -> wrong {c['right_to_wrong']}; changed {c['changed']}")
+
+
+def paired(folders, old: Callable[[dict], dict], new: Callable[[dict], dict], focus: str,
+           out=print) -> dict:
+    """The paired re-decision of saved blind sets: every saved case of ``folders``
+    (:func:`saved_cases`) decided by two verdict rules ``old`` and ``new`` (summary -> decision),
+    so a rule that needs no new record is judged on the SAME drives, with no simulation noise
+    between the columns.  Prints each drive whose verdict or confidence changed, a line per folder
+    and one for all (``focus``: the effect whose count is shown apart).  Returns the totals:
+    ``[old, new, cases]`` for ``effect``, ``null`` and ``focus``, ``[old, new]`` for ``wrong`` and
+    ``clear_wrong``, and the counts ``right_to_wrong``, ``changed``, ``drives``."""
+    total = _paired_blank()
+    for d in folders:
+        c = _paired_blank()
+        for r, s in saved_cases(d):
+            a, b = old(s), new(s)
+            ja, jb = judge(r, a["verdict"], a["confidence"]), judge(r, b["verdict"], b["confidence"])
+            key = "null" if r["effect"] == "none" else "effect"
+            c["drives"] += 1
+            for i, j in enumerate((ja, jb)):
+                c[key][i] += j["correct"]
+                c["focus"][i] += r["effect"] == focus and j["correct"]
+                c["wrong"][i] += wrong_name(r, (a, b)[i]["verdict"])
+                c["clear_wrong"][i] += j["confident_wrong"]
+            c[key][2] += 1
+            c["focus"][2] += r["effect"] == focus
+            c["right_to_wrong"] += ja["correct"] and not jb["correct"]
+            if (a["verdict"], a["confidence"]) != (b["verdict"], b["confidence"]):
+                c["changed"] += 1
+                out(f"  {d} case {r['case']} truth {r['effect']} {r.get('value')}: {a['verdict']} "
+                    f"({a['confidence']}) -> {b['verdict']} ({b['confidence']})")
+        out(_paired_line(str(d), c, focus))
+        for k, v in c.items():
+            total[k] = [x + y for x, y in zip(total[k], v)] if isinstance(v, list) else total[k] + v
+    out(_paired_line("ALL", total, focus))
+    return total
 
 
 #: threshold grid of :func:`sweep` (the committed values are on it)

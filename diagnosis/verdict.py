@@ -931,6 +931,34 @@ def _what_own(own_res: Mapping) -> str:
             "transmissibility, which it barely moves, is not used)")
 
 
+def _own_clause(own_res: Mapping, effect: str, agrees: bool, signature_max: float) -> str:
+    """The clause a reason gives for a road-independent test other than the transmissibility
+    (``_SignatureTest.own``): the front-to-rear delay of a speed error, the speed test of a
+    low-pass, or an own-signature statistic; ``agrees`` is the test's outcome (for the speed test
+    it includes the two-input transmissibility, which ``own_res['agrees']`` does not)."""
+    stat = own_res.get("statistic")
+    if stat == "front_rear_delay":
+        return delay_text(own_res) + ("" if not agrees else
+                                      " (the verdict tests a speed error on this instead of the "
+                                      "transmissibility, which a speed error leaves where it was)")
+    if stat == "hz_fixed_slope":
+        return hz_text(own_res, effect) + (
+            "" if agrees or own_res.get("two_input_ok", True) else
+            f"; its two-input transmissibility disagrees with the measurement (mean z^2 "
+            f"{own_res['two_input_chi2']:.2g}, at most {signature_max:.2g} asked): a roll-off fixed "
+            f"in Hz with a vehicle difference beside it")
+    if agrees:
+        return (f"its {_what_own(own_res)} agrees: measured {own_res['measured']:+.3f}, nominal "
+                f"model {own_res['nominal_mean']:+.3f} (z {own_res['z_nominal']:+.1f}), {effect} "
+                f"{own_res['model_mean']:+.3f} (z {own_res['z_model']:+.1f})")
+    return (f"its {_what_own(own_res)} does not single it out: measured {own_res['measured']:+.3f}, "
+            f"nominal model {own_res['nominal_mean']:+.3f} (z {own_res['z_nominal']:+.1f}, at least "
+            f"{OWN_Z_NOMINAL:g} asked), {effect} {own_res['model_mean']:+.3f} (z "
+            f"{own_res['z_model']:+.1f}, at most {OWN_Z_MODEL:g} asked; it moves the statistic "
+            f"{own_res.get('moved', float('nan')):.0%} of the way from the nominal model's value to "
+            f"the measurement, at least {OWN_SHARE:.0%} asked)")
+
+
 def _what(sig_method: str) -> str:
     return ("two-input axle-to-body transmissibility" if sig_method == "two_input"
             else "axle-to-body transmissibility")
@@ -1163,22 +1191,8 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
         short.append(f"it explains {share:.0%} of the held-out gap above a correct model's "
                      f"(at least {share_min:.0%} asked)" if math.isfinite(share) else
                      "its share of the gap above a correct model's is undefined")
-    if agrees is False and own_res is not None and own_res.get("statistic") == "front_rear_delay":
-        short.append(delay_text(own_res))
-    elif agrees is False and own_res is not None and own_res.get("statistic") == "hz_fixed_slope":
-        short.append(hz_text(own_res, win["effect"])
-                     + ("" if own_res.get("two_input_ok", True) else
-                        f"; its two-input transmissibility disagrees with the measurement (mean "
-                        f"z^2 {own_res['two_input_chi2']:.2g}, at most {signature_max:.2g} asked): "
-                        f"a roll-off fixed in Hz with a vehicle difference beside it"))
-    elif agrees is False and own_res is not None:
-        short.append(f"its {_what_own(own_res)} does not single it out: measured "
-                     f"{own_res['measured']:+.3f}, nominal model {own_res['nominal_mean']:+.3f} "
-                     f"(z {own_res['z_nominal']:+.1f}, at least {OWN_Z_NOMINAL:g} asked), "
-                     f"{win['effect']} {own_res['model_mean']:+.3f} (z {own_res['z_model']:+.1f}, "
-                     f"at most {OWN_Z_MODEL:g} asked; it moves the statistic "
-                     f"{own_res.get('moved', float('nan')):.0%} of the way from the nominal model's "
-                     f"value to the measurement, at least {OWN_SHARE:.0%} asked)")
+    if agrees is False and own_res is not None:
+        short.append(_own_clause(own_res, win["effect"], False, signature_max))
     elif unchecked:
         short.append(f"its road-independent signature cannot be checked: {NO_PAIR_TEXT}")
     elif agrees is False:
@@ -1225,15 +1239,8 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                + ("" if agrees is not True or remainder or own_res is not None or lowpass else
                   f"; its {what} agrees with the measurement")
                + remainder)
-    if own_res is not None and own_res.get("statistic") == "front_rear_delay":
-        reason += (f"; {delay_text(own_res)} (the verdict tests a speed error on this instead of "
-                   f"the transmissibility, which a speed error leaves where it was)")
-    elif own_res is not None and own_res.get("statistic") == "hz_fixed_slope":
-        reason += f"; {hz_text(own_res, win['effect'])}"
-    elif own_res is not None:
-        reason += (f"; its {_what_own(own_res)} agrees: measured {own_res['measured']:+.3f}, "
-                   f"nominal model {own_res['nominal_mean']:+.3f} (z {own_res['z_nominal']:+.1f}), "
-                   f"{win['effect']} {own_res['model_mean']:+.3f} (z {own_res['z_model']:+.1f})")
+    if own_res is not None:
+        reason += "; " + _own_clause(own_res, win["effect"], True, signature_max)
     caveats = []
     if (own_res is not None and own_res.get("agrees") and "z_nominal" in own_res
             and own_res.get("statistic") != "hz_fixed_slope"

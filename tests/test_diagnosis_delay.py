@@ -97,10 +97,10 @@ def test_saved_independent_truck_drive_without_speed_error_is_not_named():
 
 
 def test_paired_re_decision_of_a_saved_set(monkeypatch):
-    """diagnosis.redecide.paired on the committed seed-607 nominal set: with and without the delay
+    """diagnosis.blind.paired on the committed seed-607 nominal set: with and without the delay
     rule only the missed speed error changes (case 18, named; case 7 was named clear already), none goes from
     right to wrong; deciding twice with one rule changes nothing."""
-    from diagnosis.redecide import paired
+    from diagnosis.blind import paired
 
     def rule(on):
         def run(s):

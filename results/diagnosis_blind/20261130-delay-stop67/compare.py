@@ -9,7 +9,7 @@ every summary since 2026-11-21 carries."""
 import sys
 
 from diagnosis import verdict
-from diagnosis.redecide import paired
+from diagnosis.blind import paired
 
 
 def with_rule(on):

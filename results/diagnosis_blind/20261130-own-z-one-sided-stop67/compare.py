@@ -6,7 +6,7 @@ Each DIR holds blind.json and caseNNN-summary.json (a committed set) or caseNNN-
 import sys
 
 from diagnosis import verdict
-from diagnosis.redecide import paired
+from diagnosis.blind import paired
 
 OLD_Z = 2.0
 
