@@ -564,6 +564,9 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                         if S.get("n_unresolved") else "")
                      + (f"; still off: {', '.join(S['pairs_off'])}" if S.get("pairs_off") else "")
                      + ("; the verdict uses this one" if tag == used else
+                        "; the verdict named the low-pass on its nominal value (within a correct "
+                        "model's own: no vehicle-side difference shows)"
+                        if tag == "two_input" and D.get("named_on") == "two_input" else
                         "; not used by the verdict" + ("" if used else
                                                        " (it tests this effect on its own signature)"))
                      + ".")

@@ -44,6 +44,9 @@ def test_saved_tyre_enveloping_is_named_ambiguous_on_the_two_input_transmissibil
              verdict_detail=d)
     md = render_markdown(s, {})
     assert "named on the gap and the two-input transmissibility" in md
+    # "What is left" says the two-input record was used, not "not used by the verdict"
+    two_line = next(ln for ln in md.splitlines() if ln.strip().startswith("Two-input axle-to-body"))
+    assert "the verdict named the low-pass on its nominal value" in two_line, two_line
 
 
 def test_a_nominal_two_input_beyond_a_correct_models_own_is_not_named(summary):
