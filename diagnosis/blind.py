@@ -427,6 +427,28 @@ def _paired_line(name: str, c: Mapping, focus: str) -> str:
             f"{c['clear_wrong'][1]}); right -> wrong {c['right_to_wrong']}; changed {c['changed']}")
 
 
+def decide_with(**settings) -> Callable[[dict], dict]:
+    """``summary -> decision``: :func:`diagnosis.verdict.decide` with module settings of
+    :mod:`diagnosis.verdict` (e.g. ``LOWPASS_TWO_INPUT=False``) in force for the call and restored
+    after it -- the two sides of :func:`paired` for a rule switched by a module constant."""
+    from diagnosis import verdict
+
+    unknown = [k for k in settings if not hasattr(verdict, k)]
+    if unknown:
+        raise ValueError(f"diagnosis.verdict has no setting {', '.join(unknown)}")
+
+    def run(summary: dict) -> dict:
+        keep = {k: getattr(verdict, k) for k in settings}
+        try:
+            for k, v in settings.items():
+                setattr(verdict, k, v)
+            return verdict.decide(summary)
+        finally:
+            for k, v in keep.items():
+                setattr(verdict, k, v)
+    return run
+
+
 def paired(folders, old: Callable[[dict], dict], new: Callable[[dict], dict], focus: str,
            out=print) -> dict:
     """The paired re-decision of saved blind sets: every saved case of ``folders``

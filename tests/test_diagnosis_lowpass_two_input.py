@@ -84,3 +84,22 @@ def test_a_vehicle_effect_is_not_named_by_this_rule(summary):
     s["ranking_decision"]["verdict"] = "frame_flex"
     d = decide(s)
     assert d["verdict"] == "unexplained" and d["closest"] == "frame_flex", d["reason"]
+
+
+def test_paired_re_decision_with_decide_with_on_the_fresh_set():
+    """diagnosis.blind.decide_with switches a verdict setting for one call and restores it: the
+    committed fresh low-pass set re-decided without and with the rule changes exactly the one
+    drive the rule named (case 1, tyre enveloping 0.284 m), none from right to wrong."""
+    from diagnosis.blind import decide_with, paired
+
+    folder = SAVED.parents[2] / "20261130-lowpass-two-input-stop68/lowpass-nominal"
+    keep = verdict.LOWPASS_TWO_INPUT
+    lines = []
+    t = paired([folder], decide_with(LOWPASS_TWO_INPUT=False), decide_with(LOWPASS_TWO_INPUT=True),
+               "tyre_enveloping", out=lines.append)
+    assert verdict.LOWPASS_TWO_INPUT is keep
+    assert t["drives"] == 16 and t["changed"] == 1 and t["right_to_wrong"] == 0
+    assert t["focus"][1] == t["focus"][0] + 1
+    assert any("case 1 truth tyre_enveloping" in x and "-> tyre_enveloping (ambiguous)" in x for x in lines)
+    with pytest.raises(ValueError, match="no setting"):
+        decide_with(NO_SUCH_RULE=True)

@@ -5,19 +5,7 @@ Every saved summary is re-decided twice with the code's verdict rules: "old" wit
 diagnosis.verdict.LOWPASS_TWO_INPUT False, "new" with it True (stop 68)."""
 import sys
 
-from diagnosis import verdict
-from diagnosis.blind import paired
-
-
-def with_rule(on):
-    def run(s):
-        keep, verdict.LOWPASS_TWO_INPUT = verdict.LOWPASS_TWO_INPUT, on
-        try:
-            return verdict.decide(s)
-        finally:
-            verdict.LOWPASS_TWO_INPUT = keep
-    return run
-
+from diagnosis.blind import decide_with, paired
 
 if __name__ == "__main__":
-    paired(sys.argv[1:], with_rule(False), with_rule(True), "sensor")
+    paired(sys.argv[1:], decide_with(LOWPASS_TWO_INPUT=False), decide_with(LOWPASS_TWO_INPUT=True), "sensor")
