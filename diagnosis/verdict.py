@@ -156,11 +156,12 @@ VEHICLE_SHARE_MIN = 0.6
 #: Why: on every saved blind drive of our truck with a true low-pass answered `unexplained` on
 #: the single-input ratio the nominal two-input mean z^2 was 0.5-1.0 (a correct model's own
 #: 0.6-1.0), while the independent truck's no-effect drives named a low-pass by the gap showed
-#: 1.0-6.2 (its structure differs) and left gaps 3-33 sd above a correct model's.
-#: None: off.
+#: 1.0-6.2 (its structure differs) and left gaps 3-33 sd above a correct model's.  Re-decided on
+#: 1589 saved blind drives: 4 right names gained, 1 wrong (`ambiguous`: a sensor named tyre
+#: enveloping); stated, then tested on 36 fresh drives (seed 641): it fired once, right, and gave
+#: no name on a no-effect drive (results/diagnosis_blind/20261130-lowpass-two-input-stop68/).
+#: False: off.
 LOWPASS_TWO_INPUT = True
-
-
 #: low-pass effects: a causal low-pass of the recorded channels (``sensor``) or a spatial
 #: low-pass of the road input (``tyre_enveloping``).  Their filter acts on the axle and the body
 #: acceleration alike, so every channel ratio -- the axle-to-body transmissibility included --
