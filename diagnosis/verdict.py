@@ -978,6 +978,16 @@ def _own_clause(own_res: Mapping, effect: str, agrees: bool, signature_max: floa
             f"the measurement, at least {OWN_SHARE:.0%} asked)")
 
 
+def _two_input_nominal(summary: Mapping) -> tuple[float | None, float | None]:
+    """The nominal model's two-input mean z^2 against the measurement and the largest a correct
+    model reaches against itself on other road phases (``signature_two_input``:
+    ``chi2_nominal``, ``chi2_correct_model``); None for what the record does not hold."""
+    two = summary.get("signature_two_input") or {}
+    own = [float(v) for v in (two.get("chi2_correct_model") or []) if v is not None]
+    nom = two.get("chi2_nominal")
+    return (None if nom is None else float(nom)), (max(own) if own else None)
+
+
 def _what(sig_method: str) -> str:
     return ("two-input axle-to-body transmissibility" if sig_method == "two_input"
             else "axle-to-body transmissibility")
@@ -1237,20 +1247,20 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     gap_z = ((res["heldout_gap"] - res["correct_model_gap"]) / res["correct_model_sd"]
              if res.get("correct_model_sd") else float("nan"))
     unconfirmed = agrees is False or unchecked
-    on_gap_alone = (own_res is None and unconfirmed and len(short) == 1 and gap_present
-                    and rd.get("confidence") == "clear" and share >= FULL_SHARE_MIN
-                    and gap_z <= FULL_GAP_Z)
-    as_vehicle = (not on_gap_alone and own_res is None and unconfirmed and len(short) == 1
-                  and gap_present and rd.get("confidence") == "clear" and vehicle_share is not None
+    # the three ways a winner is named although test 3. did not confirm it share these: the
+    # transmissibility (or its absence) is the one failure, there is a gap beyond noise, and
+    # (gap alone, low-pass) the winner takes the whole gap
+    only_ratio_fails = own_res is None and unconfirmed and len(short) == 1 and gap_present
+    whole_gap = share >= FULL_SHARE_MIN and gap_z <= FULL_GAP_Z
+    ranking_clear = rd.get("confidence") == "clear"
+    on_gap_alone = only_ratio_fails and ranking_clear and whole_gap
+    as_vehicle = (not on_gap_alone and only_ratio_fails and ranking_clear and vehicle_share is not None
                   and share >= vehicle_share and acts_on_vehicle(win["effect"]))
-    two = summary.get("signature_two_input") or {}
-    two_corr = [float(v) for v in (two.get("chi2_correct_model") or []) if v is not None]
-    lowpass_two = (LOWPASS_TWO_INPUT and not (on_gap_alone or as_vehicle) and own_res is None
-                   and agrees is False and len(short) == 1 and gap_present
-                   and win["effect"] in LOWPASS_EFFECTS and sig_method != "two_input"
-                   and share >= FULL_SHARE_MIN and gap_z <= FULL_GAP_Z
-                   and two.get("chi2_nominal") is not None and bool(two_corr)
-                   and float(two["chi2_nominal"]) <= max(two_corr))
+    two_nominal, two_own_max = _two_input_nominal(summary)
+    lowpass_two = bool(LOWPASS_TWO_INPUT and not (on_gap_alone or as_vehicle) and only_ratio_fails
+                       and agrees is False and whole_gap and win["effect"] in LOWPASS_EFFECTS
+                       and sig_method != "two_input" and two_nominal is not None
+                       and two_own_max is not None and two_nominal <= two_own_max)
     if short and not (on_gap_alone or as_vehicle or lowpass_two):
         return dict(out, verdict="unexplained", confidence="none",
                     reason=(f"a gap is there and no library effect explains it: the closest, "
@@ -1314,7 +1324,7 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"{res['correct_model_sd']:.2g}); its single-input {what} stays off (mean z^2 {c1:.2g}, "
             f"nominal {c0:.2g}, at most {sig_max:.2g} asked), but the nominal model's two-input "
             f"transmissibility is within what a correct model reaches against itself (mean z^2 "
-            f"{float(two['chi2_nominal']):.2g}, a correct model up to {max(two_corr):.2g}): no "
+            f"{two_nominal:.2g}, a correct model up to {two_own_max:.2g}): no "
             f"vehicle-side difference shows -- not 'clear'")
     if st.corroborated:
         s2 = summary["signature_two_input"]
