@@ -162,6 +162,20 @@ VEHICLE_SHARE_MIN = 0.6
 #: no name on a no-effect drive (results/diagnosis_blind/20261130-lowpass-two-input-stop68/).
 #: False: off.
 LOWPASS_TWO_INPUT = True
+#: A VEHICLE EFFECT NAMED ON ITS TWO-INPUT TRANSMISSIBILITY (stop 69, stated and tested on fresh
+#: drives before it is switched on): a winner that changes the vehicle itself
+#: (:func:`acts_on_vehicle`) and fails only the single-input transmissibility -- its share of the
+#: gap above a correct model's at least ``share_min``, no range edge, a nominal gap beyond noise --
+#: is named (confidence "ambiguous", never ``identified``) when the CALIBRATED model's two-input
+#: transmissibility (``signature_two_input.chi2_model``, that record's model the winner) lies within
+#: what a correct model reaches against itself on other road phases (its largest
+#: ``chi2_correct_model``).  The single-input ratio moves with the road on a four-axle truck (a
+#: body station's acceleration follows both axles of its bogie and the other end's); the two-input
+#: one does not, and a vehicle the model describes well there has nothing left for the test to
+#: find.  Not the 2.0 floor of :func:`signature_threshold`: the independent truck's no-effect drives
+#: that a leaf friction shrinks reach 1.4-2.1 against a correct model's 0.7-0.9.  Found on the
+#: 1681 saved blind summaries (results/diagnosis_blind/20261130-vehicle-two-input-stop69/).
+VEHICLE_TWO_INPUT = False
 #: low-pass effects: a causal low-pass of the recorded channels (``sensor``) or a spatial
 #: low-pass of the road input (``tyre_enveloping``).  Their filter acts on the axle and the body
 #: acceleration alike, so every channel ratio -- the axle-to-body transmissibility included --
@@ -844,6 +858,16 @@ def _signature_distance(single: Mapping | None, two: Mapping | None, method: str
     return None
 
 
+#: the module settings that are keyword defaults of :func:`decide` / :func:`decide_one` (bound
+#: when the module loads): setting -> keyword.  ``diagnosis.blind.decide_with`` passes these as
+#: keywords, since changing the constant afterwards would not switch them.
+DEFAULT_KEYWORDS = {"SIGNATURE_TIE_BREAK": "tie_break", "SHARE_MIN": "share_min",
+                    "SIGNATURE_CHI2_MAX": "signature_max", "SIGNATURE_SHARE_MIN": "signature_share",
+                    "SIGNATURE_METHOD": "signature_method", "SIGNATURE_USE_NULL": "signature_null",
+                    "SIGNATURE_NULL_SD": "signature_null_sd", "SIGNATURE_CORROBORATE": "corroborate",
+                    "SIGNATURE_OWN": "own", "VEHICLE_SHARE_MIN": "vehicle_share"}
+
+
 def decide(summary: Mapping, *, tie_break: bool = SIGNATURE_TIE_BREAK, **kw) -> dict:
     """Verdict, confidence, reason and what is left, from a diagnosis summary: see
     :func:`decide_one` for the rules and the keywords.
@@ -986,6 +1010,15 @@ def _two_input_nominal(summary: Mapping) -> tuple[float | None, float | None]:
     own = [float(v) for v in (two.get("chi2_correct_model") or []) if v is not None]
     nom = two.get("chi2_nominal")
     return (None if nom is None else float(nom)), (max(own) if own else None)
+
+
+def _two_input_model(summary: Mapping, effect: str) -> float | None:
+    """The calibrated model's two-input mean z^2 against the measurement
+    (``signature_two_input.chi2_model``) when that record is of ``effect``, else None."""
+    two = summary.get("signature_two_input") or {}
+    if two.get("model") != effect or two.get("chi2_model") is None:
+        return None
+    return float(two["chi2_model"])
 
 
 def _what(sig_method: str) -> str:
@@ -1261,7 +1294,12 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
                        and agrees is False and whole_gap and win["effect"] in LOWPASS_EFFECTS
                        and sig_method != "two_input" and two_nominal is not None
                        and two_own_max is not None and two_nominal <= two_own_max)
-    if short and not (on_gap_alone or as_vehicle or lowpass_two):
+    two_model = _two_input_model(summary, win["effect"])
+    vehicle_two = bool(VEHICLE_TWO_INPUT and not (on_gap_alone or as_vehicle or lowpass_two)
+                       and only_ratio_fails and agrees is False and acts_on_vehicle(win["effect"])
+                       and sig_method != "two_input" and two_model is not None
+                       and two_own_max is not None and two_model <= two_own_max)
+    if short and not (on_gap_alone or as_vehicle or lowpass_two or vehicle_two):
         return dict(out, verdict="unexplained", confidence="none",
                     reason=(f"a gap is there and no library effect explains it: the closest, "
                             f"{win['effect']}, shrinks the held-out gap from "
@@ -1326,6 +1364,14 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
             f"transmissibility is within what a correct model reaches against itself (mean z^2 "
             f"{two_nominal:.2g}, a correct model up to {two_own_max:.2g}): no "
             f"vehicle-side difference shows -- not 'clear'")
+    if vehicle_two:
+        caveats.append(
+            f"; named on its two-input transmissibility: its single-input {what} stays off (mean "
+            f"z^2 {c1:.2g}, nominal {c0:.2g}, at most {sig_max:.2g} asked; that ratio moves with the "
+            f"road on a four-axle truck), but its two-input transmissibility (a station's body on "
+            f"both of its axles) is within what a correct model reaches against itself (mean z^2 "
+            f"{two_model:.2g}, nominal {two_nominal:.2g}, a correct model up to {two_own_max:.2g}) "
+            f"-- not 'clear'")
     if st.corroborated:
         s2 = summary["signature_two_input"]
         caveats.append(
@@ -1379,9 +1425,11 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     return dict(out, verdict=rv, confidence=conf, reason=reason,
                 identified=bool(rd.get("confidence") == "clear" and not edges and gap_present
                                 and not weak and not lowpass and not on_gap_alone and not on_signature
-                                and not as_vehicle and not st.corroborated and dropped is None),
+                                and not as_vehicle and not vehicle_two and not st.corroborated
+                                and dropped is None),
                 named_on=("gap_alone" if on_gap_alone else "vehicle_share" if as_vehicle
-                          else "two_input" if lowpass_two else "signature" if on_signature else None))
+                          else "two_input" if (lowpass_two or vehicle_two)
+                          else "signature" if on_signature else None))
 
 
 #: why test 3. cannot be made on a drive without an axle and a body acceleration at one station
