@@ -38,7 +38,7 @@ from matplotlib.figure import Figure
 
 from eroad.errors import EroadInputError
 
-from .verdict import GAP_SIDE_MEASURED, decide, own_statistic
+from .verdict import GAP_SIDE_MEASURED, LOWPASS_EFFECTS, decide, own_statistic
 
 __all__ = ["build_summary", "write_report", "plot_heatmap", "plot_segments",
            "plot_transmissibility", "plot_ranking", "plot_shrink_bands", "render_markdown",
@@ -469,6 +469,17 @@ def _calibrated_value(summary: Mapping, verdict: str) -> str:
     return (", calibrated " + "; ".join(parts)) if parts else ""
 
 
+def _two_input_use(record: dict, verdict: str | None) -> str:
+    """What the verdict read from the two-input record where it named an effect on it: a low-pass on
+    the NOMINAL model's value (the effect leaves channel ratios alone), a vehicle effect on its own
+    calibrated model's value."""
+    if record.get("model") == verdict and verdict not in LOWPASS_EFFECTS:
+        return (f"; the verdict named {verdict} on its calibrated value (within a correct model's own: "
+                "nothing left there for the test to find)")
+    return ("; the verdict named the low-pass on its nominal value (within a correct model's own: no "
+            "vehicle-side difference shows)")
+
+
 def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
     """The readable report (Markdown) from a summary and figure file names."""
     L = []
@@ -564,8 +575,7 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
                         if S.get("n_unresolved") else "")
                      + (f"; still off: {', '.join(S['pairs_off'])}" if S.get("pairs_off") else "")
                      + ("; the verdict uses this one" if tag == used else
-                        "; the verdict named the low-pass on its nominal value (within a correct "
-                        "model's own: no vehicle-side difference shows)"
+                        _two_input_use(S, D.get("verdict"))
                         if tag == "two_input" and D.get("named_on") == "two_input" else
                         "; not used by the verdict" + ("" if used else
                                                        " (it tests this effect on its own signature)"))

@@ -55,6 +55,10 @@ Vocabulary
     loop (``diagnosis.closed_loop``) corrects with every named effect whose value is not at a
     range edge, whatever its confidence, and says which of these it was.  The front-to-rear delay and the amplitude distribution
        (skewness) are terms of every gap the ranking scores, so 1. already asks them.
+       Named on the two-input transmissibility (``LOWPASS_TWO_INPUT``, ``VEHICLE_TWO_INPUT``):
+       a winner failing only the single-input ratio, which moves with the road on a four-axle
+       truck, when the two-input record shows no difference a correct model would not
+       (``ambiguous``, never ``identified``).
 
     ``confidence`` is ``clear`` when no rival sharing no effect comes within the
     nominal-vs-nominal gap's sd, the calibrated parameter is not at an edge of its

@@ -105,3 +105,15 @@ def test_decide_with_switches_keyword_default_settings():
     assert verdict.SIGNATURE_METHOD == "single_input"
     with pytest.raises(ValueError, match="no setting"):
         decide_with(NO_SUCH_RULE=True)
+
+
+def test_the_report_says_the_calibrated_two_input_record_was_used(summary, rule_on):
+    from diagnosis.report import render_markdown
+
+    d = decide(summary)
+    s = dict(summary, verdict=d["verdict"], verdict_confidence=d["confidence"], verdict_reason=d["reason"],
+             verdict_detail=d)
+    md = render_markdown(s, {})
+    assert "named on its two-input transmissibility" in md
+    two_line = next(ln for ln in md.splitlines() if ln.strip().startswith("Two-input axle-to-body"))
+    assert "the verdict named frame_flex on its calibrated value" in two_line, two_line
