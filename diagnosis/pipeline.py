@@ -1000,7 +1000,8 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
             "road_high_band": (None if model.high_band is None else
                                {"cut": [segs[k][0] for k in model.high_band["cut"]],
                                 "rolloff": [segs[k][0] for k in model.high_band["rolloff"]],
-                                "vetoed": model.high_band["vetoed"]}),
+                                "vetoed": model.high_band["vetoed"],
+                                "unstepped": bool(model.high_band.get("unstepped", False))}),
             "road_fit": ("segment level and waviness from the nominal model on the calibration "
                          "windows" if road_fit == "levels" else
                          "inverse.pipeline.invert on the whole record (nominal truck)")

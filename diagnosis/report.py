@@ -825,6 +825,11 @@ def _road_text(summary: Mapping) -> list:
                  "of the vehicle or the sensors (tyre enveloping, a sensor low-pass) acts on every "
                  "segment, and segments that looked cut are too smooth to show it above the noise. "
                  "The candidates take the roll-off up.")
+    elif hb.get("unstepped"):
+        L.append("\nThe measured high band looked cut, but the axle accelerations read against "
+                 "spatial frequency step down nowhere, as a road that stops would at every speed: "
+                 "no segment is cut, and the fall-off (a low-pass fixed in Hz, e.g. a sensor's) is "
+                 "left to the candidates.")
     elif hb.get("cut"):
         L.append("\nCut road (nothing above nmax, the measurement above it is noise) in "
                  + ", ".join(hb["cut"]) + ": e.g. a measured profile sampled every 0.25 m holds "

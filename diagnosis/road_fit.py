@@ -271,6 +271,19 @@ NMAX_ABOVE, NMAX_CUT_TOL = 1.1, 0.7
 #: 9.1 Hz) and of none of the six measured-profile drives cut at 2 cycles/m (every segment
 #: cut, no roll-off).  Not caught: a 7.7 Hz sensor drive whose every segment looked cut.
 NMAX_ROLLOFF_VETO = True
+#: A CUT THE SPATIAL SPECTRUM DOES NOT SHOW IS NOT THE ROAD'S (stop 69; stated and tested on
+#: fresh drives before it is switched on): where :func:`fit_nmax` cuts a segment and the measured
+#: axle accelerations read against spatial frequency (:func:`diagnosis.band_edge.trial_cut`, the
+#: measurement alone) step down at no grid value (no statistic reaching ``band_edge.STEP_MIN``, with
+#: usable windows), no segment is cut.  Why: a road that stops at n_c steps down there at every
+#: speed; a sensor low-pass so steep (cutoff far below 20 Hz) that the band above it is noise on
+#: every segment looks cut to ``fit_nmax`` -- the veto above needs one segment showing a roll-off --
+#: and, cut, the road (w at its upper bound, nmax 2-3) takes the low-pass up, so no candidate has
+#: anything left to explain.  On the saved blind summaries whose fitted band cut a segment (about
+#: 260), the step stayed below 1.0 on 4 only, all sensor low-passes (6.1, 6.8, 9.0, 34 Hz; three of
+#: them missed); every measured-profile drive (the roads that ARE cut) stepped at >= 1.0
+#: (results/diagnosis_blind/20261130-spatial-step-stop69/).
+NMAX_SPATIAL_STEP = False
 
 
 def _pooled_psd(sig: Signals, sim: dict, mask: np.ndarray, names, min_run: int = 512):
@@ -454,13 +467,21 @@ def fit_nmax(model: TruckModel, sig: Signals, gq, seed: int = 0, diag: dict | No
             if todo.any():
                 stat(g, todo, ~np.isfinite(d[g0]))
     out, rolloff, vetoed = choose_nmax(d, e, low)
+    unstepped = False
+    if NMAX_SPATIAL_STEP and np.any(out < ROAD_NMAX):
+        from diagnosis.band_edge import trial_cut
+
+        tc = trial_cut(sig, NMAX_GRID, ROAD_NMAX)
+        if tc["windows"] and tc["cut"] is None:
+            out[:] = ROAD_NMAX
+            unstepped = True
     # segments too short for the statistic take the value of the nearest one that has it
     # (the record's road: a short segment left at 5 between cut ones put the whole excess
     # back for its seconds)
     out = nearest_fill(out, np.isfinite(d[g0]), model.bounds)
     model.nmax = out
     model.high_band = {"cut": [int(k) for k in np.nonzero(out < ROAD_NMAX)[0]],
-                       "rolloff": list(rolloff), "vetoed": bool(vetoed)}
+                       "rolloff": list(rolloff), "vetoed": bool(vetoed), "unstepped": unstepped}
     if diag is not None:
         diag.update(d=d, e=e, vmax=vmax, band=band, rolloff=rolloff, vetoed=vetoed)
     return out
