@@ -178,7 +178,10 @@ LOWPASS_TWO_INPUT = True
 #: one does not, and a vehicle the model describes well there has nothing left for the test to
 #: find.  Not the 2.0 floor of :func:`signature_threshold`: the independent truck's no-effect drives
 #: that a leaf friction shrinks reach 1.4-2.1 against a correct model's 0.7-0.9.  Found on the
-#: 1681 saved blind summaries (results/diagnosis_blind/20261130-vehicle-two-input-stop69/).
+#: 1681 saved blind summaries (+3 right, nothing else changed); stated, then 88 fresh drives (seeds 647
+#: and 653, 16 of them frame flexibilities and bump stops aimed at it): it fired on none, so the bar
+#: (at least one right name) was not met and it stays off
+#: (results/diagnosis_blind/20261130-vehicle-two-input-stop69/).  False: off.
 VEHICLE_TWO_INPUT = False
 #: low-pass effects: a causal low-pass of the recorded channels (``sensor``) or a spatial
 #: low-pass of the road input (``tyre_enveloping``).  Their filter acts on the axle and the body
