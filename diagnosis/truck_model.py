@@ -106,7 +106,8 @@ class TruckModel:
     lift_times: np.ndarray | None = None
     #: what :func:`diagnosis.road_fit.fit_nmax` decided about the high band, for the report:
     #: ``{"cut": [segment indices cut], "rolloff": [segment indices that roll off],
-    #: "vetoed": bool}``
+    #: "vetoed": bool, "unstepped": bool}`` (``unstepped``: cuts left out because the spatial
+    #: spectrum showed no step, ``road_fit.NMAX_SPATIAL_STEP``)
     high_band: dict | None = None
     #: the inputs :func:`diagnosis.road_fit.fit_road` gave ``fit_nmax`` (``{"gq", "noise"}``),
     #: so that :func:`diagnosis.road_fit.refit_band` repeats that fit with only the effects
