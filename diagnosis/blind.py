@@ -436,17 +436,15 @@ def decide_with(**settings) -> Callable[[dict], dict]:
     unknown = [k for k in settings if not hasattr(verdict, k)]
     if unknown:
         raise ValueError(f"diagnosis.verdict has no setting {', '.join(unknown)}")
-    # settings that are a keyword's default of decide / decide_one are bound when the module
-    # loads, so setting the module constant would not switch them: they go in as keywords
-    kwargs = {verdict.DEFAULT_KEYWORDS[k]: v for k, v in settings.items() if k in verdict.DEFAULT_KEYWORDS}
-    module = {k: v for k, v in settings.items() if k not in verdict.DEFAULT_KEYWORDS}
 
     def run(summary: dict) -> dict:
-        keep = {k: getattr(verdict, k) for k in module}
+        # every verdict function reads its settings when called (verdict._or_setting), so the
+        # module constants set here are the ones in force, keyword defaults included
+        keep = {k: getattr(verdict, k) for k in settings}
         try:
-            for k, v in module.items():
+            for k, v in settings.items():
                 setattr(verdict, k, v)
-            return verdict.decide(summary, **kwargs)
+            return verdict.decide(summary)
         finally:
             for k, v in keep.items():
                 setattr(verdict, k, v)

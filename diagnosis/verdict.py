@@ -86,6 +86,16 @@ import numpy as np
 # edge": defined beside the ranking's fold choice, which must agree with the verdict on it
 from diagnosis.which import EDGE_TOL
 
+#: the default of a keyword that stands for a module setting: the setting of that name is read
+#: when the function is CALLED, not when the module loads, so a setting changed at run time
+#: (``diagnosis.blind.decide_with``, a test's monkeypatch) is the one in force everywhere
+_SETTING = object()
+
+
+def _or_setting(value, setting):
+    """``value``, or the module ``setting`` where the keyword was left at :data:`_SETTING`."""
+    return setting if value is _SETTING else value
+
 #: least share of the held-out gap above a correct model's that a named effect explains.
 #: Set on the 18-drive blind set of the independent truth family (the rule of
 #: ``diagnosis.blind.sweep``: no confident wrong answer, then the mean of the right-effect
@@ -487,8 +497,8 @@ def own_signature(effect: str, measured: float, nominal, model) -> dict:
             "model": [_f(v) for v in model]}
 
 
-def own_signature_agrees(record: Mapping, z_nominal: float = OWN_Z_NOMINAL,
-                         z_model: float = OWN_Z_MODEL, share: float = OWN_SHARE) -> dict:
+def own_signature_agrees(record: Mapping, z_nominal: float = _SETTING,
+                         z_model: float = _SETTING, share: float = _SETTING) -> dict:
     """Does the own signature give positive evidence for the candidate?
 
     With ``m`` the measured value, ``a`` and ``b`` the nominal and candidate models' values
@@ -501,6 +511,9 @@ def own_signature_agrees(record: Mapping, z_nominal: float = OWN_Z_NOMINAL,
     of the nominal's difference, ``(mean b - mean a) / (m - mean a) >= share`` (an overshoot is
     bounded by ``z_model`` alone).  Returns the numbers, ``moved`` (that fraction) and
     ``agrees`` (None where the record lacks values)."""
+    z_nominal = _or_setting(z_nominal, OWN_Z_NOMINAL)
+    z_model = _or_setting(z_model, OWN_Z_MODEL)
+    share = _or_setting(share, OWN_SHARE)
     m = record.get("measured")
     a = np.asarray([v for v in record.get("nominal") or [] if v is not None], float)
     b = np.asarray([v for v in record.get("model") or [] if v is not None], float)
@@ -637,7 +650,7 @@ def delay_text(res: Mapping) -> str:
             f"{DELAY_AGREE:.0%} outside)")
 
 
-def hz_test(record: Mapping, effect: str, z: float = HZ_Z, moved_range=HZ_MOVED,
+def hz_test(record: Mapping, effect: str, z: float = _SETTING, moved_range=_SETTING,
             rule: str | None = None) -> dict:
     """The speed test of low-pass ``effect`` on a ``signature_hz`` record: the numbers as
     :func:`own_signature_agrees` gives them (``z_nominal``, ``z_model``, ``sd``, ``moved``, the
@@ -647,6 +660,8 @@ def hz_test(record: Mapping, effect: str, z: float = HZ_Z, moved_range=HZ_MOVED,
     test has no power; tyre enveloping: None, the test does not confirm it) and ``refutes``
     (tyre enveloping: deficit and moved below ``moved_range[0]``; what rule "replace" reads).
     ``agrees`` None and ``refutes`` False where the record lacks the values."""
+    z = _or_setting(z, HZ_Z)
+    moved_range = _or_setting(moved_range, HZ_MOVED)
     rule = HZ_RULE if rule is None else rule
     m = record.get("measured")
     a = np.asarray([v for v in record.get("nominal") or [] if v is not None and math.isfinite(v)], float)
@@ -680,7 +695,7 @@ def hz_text(res: Mapping, effect: str) -> str:
             f"{HZ_MOVED[1]:.0%} asked)")
 
 
-def own_side(measured, nominal, z_nominal: float = OWN_Z_SIDE, statistic: str | None = None) -> int:
+def own_side(measured, nominal, z_nominal: float = _SETTING, statistic: str | None = None) -> int:
     """Which way the measurement's own-signature statistic departs from the nominal model's:
     +1 (-1) where it lies at least ``z_nominal`` prediction sd above (below) the mean of the
     nominal model's values on the signature's road phases, else 0.  The prediction sd is
@@ -688,6 +703,7 @@ def own_side(measured, nominal, z_nominal: float = OWN_Z_SIDE, statistic: str | 
     freedom) and the floor of ``statistic`` (:func:`own_statistic`; default the one in use) --
     the candidate's values do not exist yet when the search range is set
     (``diagnosis.pipeline.OWN_SIDE``)."""
+    z_nominal = _or_setting(z_nominal, OWN_Z_SIDE)
     a = np.asarray([v for v in (nominal or []) if v is not None], float)
     if measured is None or a.size < 2 or not math.isfinite(float(measured)):
         return 0
@@ -697,8 +713,8 @@ def own_side(measured, nominal, z_nominal: float = OWN_Z_SIDE, statistic: str | 
     return 1 if z >= z_nominal else (-1 if z <= -z_nominal else 0)
 
 
-def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_MAX,
-                        level: float = SIGNATURE_NULL_LEVEL, pooled_sd: float | None = None) -> float:
+def signature_threshold(record: Mapping, signature_max: float = _SETTING,
+                        level: float = _SETTING, pooled_sd: float | None = None) -> float:
     """The largest mean z^2 at which a signature agrees on this drive.
 
     ``signature_max``, or -- where it is higher -- the one-sided ``level`` prediction bound
@@ -712,6 +728,8 @@ def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_M
     for the nominal model against itself on one blind drive, docs/diagnosis.md); at 0.95 a
     correct model is rejected about once in 20.
     """
+    signature_max = _or_setting(signature_max, SIGNATURE_CHI2_MAX)
+    level = _or_setting(level, SIGNATURE_NULL_LEVEL)
     null = [float(v) for v in (record.get("chi2_correct_model") or [])
             if v is not None and math.isfinite(v) and v > 0]
     if not null:
@@ -732,12 +750,13 @@ def signature_threshold(record: Mapping, signature_max: float = SIGNATURE_CHI2_M
     return max(float(signature_max), bound)
 
 
-def chosen_signature(summary: Mapping, method: str = SIGNATURE_METHOD) -> tuple[dict, str]:
+def chosen_signature(summary: Mapping, method: str = _SETTING) -> tuple[dict, str]:
     """The signature record the verdict uses and its method: ``summary["signature_two_input"]``
     for ``two_input`` when it holds both numbers and at least one tested cell, else
     ``summary["signature"]`` (single input; what summaries before the two-input estimate
     hold, and the fallback where no station has both axle accelerations or no band is
     resolved)."""
+    method = _or_setting(method, SIGNATURE_METHOD)
     if method not in SIGNATURE_METHODS:
         raise ValueError(f"signature_method must be one of {', '.join(SIGNATURE_METHODS)}, "
                          f"got {method!r}")
@@ -836,8 +855,8 @@ def residual(summary: Mapping, entry: Mapping | None, top: int = 3) -> dict:
             "bands_left": bands}
 
 
-def signature_agrees(c0, c1, signature_max: float = SIGNATURE_CHI2_MAX,
-                     signature_share: float = SIGNATURE_SHARE_MIN):
+def signature_agrees(c0, c1, signature_max: float = _SETTING,
+                     signature_share: float = _SETTING):
     """Does the candidate's transmissibility agree with the measurement?  ``c0``, ``c1``:
     mean z^2 of the nominal and of the candidate model (None: not computed -> None).
     Yes when ``c1 <= signature_max`` (within what a correct model gives), or when the
@@ -845,6 +864,8 @@ def signature_agrees(c0, c1, signature_max: float = SIGNATURE_CHI2_MAX,
     excess ``c0 - 1`` (the effect is there, beside differences no library lists: the
     remainder is reported).  An effect that leaves an off transmissibility as it was (a
     sensor low-pass, tyre enveloping: both act on axle and body alike) does not agree."""
+    signature_max = _or_setting(signature_max, SIGNATURE_CHI2_MAX)
+    signature_share = _or_setting(signature_share, SIGNATURE_SHARE_MIN)
     if c1 is None:
         return None
     if c1 <= signature_max:
@@ -865,17 +886,7 @@ def _signature_distance(single: Mapping | None, two: Mapping | None, method: str
     return None
 
 
-#: the module settings that are keyword defaults of :func:`decide` / :func:`decide_one` (bound
-#: when the module loads): setting -> keyword.  ``diagnosis.blind.decide_with`` passes these as
-#: keywords, since changing the constant afterwards would not switch them.
-DEFAULT_KEYWORDS = {"SIGNATURE_TIE_BREAK": "tie_break", "SHARE_MIN": "share_min",
-                    "SIGNATURE_CHI2_MAX": "signature_max", "SIGNATURE_SHARE_MIN": "signature_share",
-                    "SIGNATURE_METHOD": "signature_method", "SIGNATURE_USE_NULL": "signature_null",
-                    "SIGNATURE_NULL_SD": "signature_null_sd", "SIGNATURE_CORROBORATE": "corroborate",
-                    "SIGNATURE_OWN": "own", "VEHICLE_SHARE_MIN": "vehicle_share"}
-
-
-def decide(summary: Mapping, *, tie_break: bool = SIGNATURE_TIE_BREAK, **kw) -> dict:
+def decide(summary: Mapping, *, tie_break: bool = _SETTING, **kw) -> dict:
     """Verdict, confidence, reason and what is left, from a diagnosis summary: see
     :func:`decide_one` for the rules and the keywords.
 
@@ -887,6 +898,7 @@ def decide(summary: Mapping, *, tie_break: bool = SIGNATURE_TIE_BREAK, **kw) -> 
     have it.  The gap cannot tell the two apart, the road-independent statistic can.  Only
     ever one name for another: a drive answered ``none`` or ``unexplained`` stays so.
     """
+    tie_break = _or_setting(tie_break, SIGNATURE_TIE_BREAK)
     d = decide_one(summary, **kw)
     swapped = _lowpass_swap(summary, d, **kw)
     if swapped is not None:
@@ -1009,23 +1021,16 @@ def _own_clause(own_res: Mapping, effect: str, agrees: bool, signature_max: floa
             f"the measurement, at least {OWN_SHARE:.0%} asked)")
 
 
-def _two_input_nominal(summary: Mapping) -> tuple[float | None, float | None]:
-    """The nominal model's two-input mean z^2 against the measurement and the largest a correct
-    model reaches against itself on other road phases (``signature_two_input``:
-    ``chi2_nominal``, ``chi2_correct_model``); None for what the record does not hold."""
+def _two_input_numbers(summary: Mapping, effect: str) -> tuple[float | None, float | None, float | None]:
+    """From ``signature_two_input``: the nominal model's mean z^2 against the measurement, the
+    calibrated model's (where the record is of ``effect``) and the largest a correct model reaches
+    against itself on other road phases; None for what the record does not hold."""
     two = summary.get("signature_two_input") or {}
     own = [float(v) for v in (two.get("chi2_correct_model") or []) if v is not None]
-    nom = two.get("chi2_nominal")
-    return (None if nom is None else float(nom)), (max(own) if own else None)
-
-
-def _two_input_model(summary: Mapping, effect: str) -> float | None:
-    """The calibrated model's two-input mean z^2 against the measurement
-    (``signature_two_input.chi2_model``) when that record is of ``effect``, else None."""
-    two = summary.get("signature_two_input") or {}
-    if two.get("model") != effect or two.get("chi2_model") is None:
-        return None
-    return float(two["chi2_model"])
+    nom, mod = two.get("chi2_nominal"), two.get("chi2_model")
+    return ((None if nom is None else float(nom)),
+            (None if mod is None or two.get("model") != effect else float(mod)),
+            (max(own) if own else None))
 
 
 def _what(sig_method: str) -> str:
@@ -1178,15 +1183,15 @@ def _no_winner(summary: Mapping, base: dict, gap_present: bool) -> dict:
                 residual=residual(summary, None))
 
 
-def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
-               signature_max: float = SIGNATURE_CHI2_MAX,
-               signature_share: float = SIGNATURE_SHARE_MIN,
-               signature_method: str = SIGNATURE_METHOD,
-               signature_null: bool = SIGNATURE_USE_NULL,
-               signature_null_sd: float | None = SIGNATURE_NULL_SD,
-               corroborate: bool = SIGNATURE_CORROBORATE,
-               own: bool = SIGNATURE_OWN,
-               vehicle_share: float | None = VEHICLE_SHARE_MIN) -> dict:
+def decide_one(summary: Mapping, *, share_min: float = _SETTING,
+               signature_max: float = _SETTING,
+               signature_share: float = _SETTING,
+               signature_method: str = _SETTING,
+               signature_null: bool = _SETTING,
+               signature_null_sd: float | None = _SETTING,
+               corroborate: bool = _SETTING,
+               own: bool = _SETTING,
+               vehicle_share: float | None = _SETTING) -> dict:
     """Verdict, confidence, reason and what is left, from a diagnosis summary.
 
     Reads ``summary["ranking"]`` (entries, accepted first), ``summary["ranking_decision"]``
@@ -1206,6 +1211,15 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     ``signature_method`` (the transmissibility used), ``residual`` (see :func:`residual`),
     ``thresholds``.
     """
+    share_min = _or_setting(share_min, SHARE_MIN)
+    signature_max = _or_setting(signature_max, SIGNATURE_CHI2_MAX)
+    signature_share = _or_setting(signature_share, SIGNATURE_SHARE_MIN)
+    signature_method = _or_setting(signature_method, SIGNATURE_METHOD)
+    signature_null = _or_setting(signature_null, SIGNATURE_USE_NULL)
+    signature_null_sd = _or_setting(signature_null_sd, SIGNATURE_NULL_SD)
+    corroborate = _or_setting(corroborate, SIGNATURE_CORROBORATE)
+    own = _or_setting(own, SIGNATURE_OWN)
+    vehicle_share = _or_setting(vehicle_share, VEHICLE_SHARE_MIN)
     nom = summary.get("nominal") or {}
     rd = summary.get("ranking_decision") or {}
     ranking = list(summary.get("ranking") or [])
@@ -1296,16 +1310,15 @@ def decide_one(summary: Mapping, *, share_min: float = SHARE_MIN,
     on_gap_alone = only_ratio_fails and ranking_clear and whole_gap
     as_vehicle = (not on_gap_alone and only_ratio_fails and ranking_clear and vehicle_share is not None
                   and share >= vehicle_share and acts_on_vehicle(win["effect"]))
-    two_nominal, two_own_max = _two_input_nominal(summary)
-    lowpass_two = bool(LOWPASS_TWO_INPUT and not (on_gap_alone or as_vehicle) and only_ratio_fails
-                       and agrees is False and whole_gap and win["effect"] in LOWPASS_EFFECTS
-                       and sig_method != "two_input" and two_nominal is not None
-                       and two_own_max is not None and two_nominal <= two_own_max)
-    two_model = _two_input_model(summary, win["effect"])
-    vehicle_two = bool(VEHICLE_TWO_INPUT and not (on_gap_alone or as_vehicle or lowpass_two)
-                       and only_ratio_fails and agrees is False and acts_on_vehicle(win["effect"])
-                       and sig_method != "two_input" and two_model is not None
-                       and two_own_max is not None and two_model <= two_own_max)
+    # named on the two-input record: the single-input ratio is what failed, the two-input one
+    # holds a correct model's own scatter to compare with
+    two_nominal, two_model, two_own_max = _two_input_numbers(summary, win["effect"])
+    on_two = (not (on_gap_alone or as_vehicle) and only_ratio_fails and agrees is False
+              and sig_method != "two_input" and two_own_max is not None)
+    lowpass_two = bool(LOWPASS_TWO_INPUT and on_two and whole_gap and win["effect"] in LOWPASS_EFFECTS
+                       and two_nominal is not None and two_nominal <= two_own_max)
+    vehicle_two = bool(VEHICLE_TWO_INPUT and on_two and not lowpass_two and acts_on_vehicle(win["effect"])
+                       and two_model is not None and two_model <= two_own_max)
     if short and not (on_gap_alone or as_vehicle or lowpass_two or vehicle_two):
         return dict(out, verdict="unexplained", confidence="none",
                     reason=(f"a gap is there and no library effect explains it: the closest, "
