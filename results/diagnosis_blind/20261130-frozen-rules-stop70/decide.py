@@ -58,7 +58,7 @@ def main(dirs):
             wrong = sum(wrong_name(r, r["verdict"]) for r in rs)
             print(f"{label}, {road} roads: top-1 {frac(k1, len(eff))}; no effect none/unexplained "
                   f"{frac(kn, len(nul))}; values x1.5 {frac(kv, len(right))}; wrong names {wrong}")
-            if eff and road != "measured" and not (family == "second" and road == "iso"):
+            if eff and road != "measured":
                 checks.append((f"top-1 >= 90 %, {label}, {road} roads", k1 / len(eff) >= 0.9))
             if nul:
                 checks.append((f"none/unexplained >= 90 %, {label}, {road} roads", kn / len(nul) >= 0.9))
