@@ -538,6 +538,14 @@ def _family_score(rs: list[dict]) -> dict:
             "no_effect_right": _rate([r["correct"] for r in rs if r["effect"] == "none"])}
 
 
+def detectable(r: dict) -> bool:
+    """Whether a blind case's truth shows its own effect: the truth effect at its true strength
+    passes the ranking's gate (a positive held-out improvement, paired z above ``Z_PAIRED``).
+    Only cases whose truth is our own model carry ``true_paired_z``; others are never detectable."""
+    return (r.get("true_paired_z") is not None and (r.get("true_shrink") or 0) > 0
+            and r["true_paired_z"] > Z_PAIRED)
+
+
 def score(results: list[dict]) -> dict:
     """Confusion matrix (truth rows x verdict columns) and the target metrics."""
     labels = sorted({r["effect"] for r in results} | {r["verdict"] for r in results},
@@ -548,10 +556,7 @@ def score(results: list[dict]) -> dict:
         cm[idx[r["effect"]], idx[r["verdict"]]] += 1
     eff = [r for r in results if r["effect"] != "none"]
     nul = [r for r in results if r["effect"] == "none"]
-    # detectable: the truth effect at its true strength would pass the ranking's gate
-    # (positive held-out improvement, paired z above Z_PAIRED)
-    det = [r for r in eff if r.get("true_paired_z") is not None and r["true_shrink"] > 0
-           and r["true_paired_z"] > Z_PAIRED]
+    det = [r for r in eff if detectable(r)]
     pairs = [(r["predicted_shrink"], r["true_shrink"]) for r in eff
              if r["correct"] and r["true_shrink"] is not None]
     return {

@@ -7,22 +7,15 @@ independent truck has no run of its own effect to measure it on). A miss lists t
 import sys
 from collections import defaultdict
 
-from diagnosis.blind import Z_PAIRED, rescore
-
-
-def shows(r):
-    """The score's 'detectable' (diagnosis.blind.score): the truth's own effect at its true value improves
-    the held-out gap by more than Z_PAIRED sd of its paired noise."""
-    return (r.get("true_paired_z") is not None and (r.get("true_shrink") or 0) > 0
-            and r["true_paired_z"] > Z_PAIRED)
+from decide import truth_model   # this folder's decide.py: our truck or the independent one
+from diagnosis.blind import detectable, rescore
 
 
 def main(dirs):
     table = defaultdict(lambda: {"nominal": [], "second": []})
     for d in dirs:
         for r in rescore(d)["results"]:
-            truck = "second" if r.get("family") == "second" else "nominal"
-            table[r["effect"]][truck].append(r)
+            table[r["effect"]][truth_model(r)].append(r)
     print("| truth | our truck: right / drives (the truth shows: right / drives) | misses answered | "
           "independent truck: right / drives | misses answered |")
     print("|---|---|---|---|---|")
@@ -34,7 +27,7 @@ def main(dirs):
                 cells += ["-", ""]
                 continue
             right = sum(r["correct"] for r in rs)
-            det = [r for r in rs if shows(r)]
+            det = [r for r in rs if detectable(r)]
             seen = f" ({sum(r['correct'] for r in det)} / {len(det)})" if truck == "nominal" and effect != "none" else ""
             misses = ", ".join(sorted(r["verdict"] for r in rs if not r["correct"]))
             cells += [f"{right} / {len(rs)}{seen}", misses]
