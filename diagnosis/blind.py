@@ -251,19 +251,14 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
     t2 = _time.perf_counter()
     # scoring only from here: truth is read
     truth = read_truth(ds)
-    truth_eff = (truth.get("vehicle", {}).get("truth", {}) or {}).get("effects") or {}
-    if case.get("family", "nominal") == "second":
-        truth_eff = {}      # no oracle: the Exudyn model with the effect is not the truth
+    truth_eff, oracle_kind = oracle_effects(case, truth)
     case = dict(case, seed=int(truth.get("seed", case["seed"])))   # the seed actually used
     verdict = summ["verdict"]
     entry = next((e for e in summ.get("ranking", []) if e["effect"] == verdict), None)
     pred_shrink = float(entry["shrink_fraction"]) if entry else 0.0
     true_shrink = true_z = None
     if truth_eff:
-        oracle = {k: dict(v) for k, v in truth_eff.items()}
-        if "sensor" in oracle:        # the nominal model carries the measured noise floor
-            oracle["sensor"].update(acc_noise=0.0, disp_noise=0.0)
-        hs = heldout_shrink(blind, oracle, n_seeds=settings["n_seeds"], n_null=settings["n_null"],
+        hs = heldout_shrink(blind, truth_eff, n_seeds=settings["n_seeds"], n_null=settings["n_null"],
                             nmax=reported_nmax(summ))
         true_shrink, true_z = hs["shrink_fraction"], hs["paired_z"]
     t3 = _time.perf_counter()
@@ -278,6 +273,7 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
                localisation_hit=localisation_hit(summ, case["effect"], case["value"]),
                n_flagged=sum(1 for c in summ.get("localization", []) if c.get("significant")),
                predicted_shrink=pred_shrink, true_shrink=true_shrink, true_paired_z=true_z,
+               oracle=oracle_kind if true_shrink is not None else None,
                best_parameters=entry["parameters"] if entry else None,
                heldout_gap_before=float(summ["nominal"]["heldout_gap"]),
                null_sd=float(summ["nominal"]["null_gap_std"]),
@@ -290,6 +286,28 @@ def run_case(case: dict, root, *, workers: int = 2, settings=None, duration=None
              f"true {'-' if true_shrink is None else format(true_shrink, '.2f')}  "
              f"loc {'hit' if res['localisation_hit'] else 'miss'}  {t2 - t1:.0f} s")
     return res
+
+
+def oracle_effects(case: Mapping, truth: Mapping) -> tuple[dict, str]:
+    """The effects the oracle puts in the nominal model to measure whether a case's truth shows
+    its effect (:func:`detectable`), and what they are.
+
+    Our own truck (families ``nominal``, ``measured``): the truth's own effects (``"truth"``; a
+    sensor without its noise floor, which the nominal model carries already).  The independently
+    written truck (``second``): its effects are its own model, not ours, so the oracle is the
+    LIBRARY's effect at the truth's strength (``"library"``): whether the data show the effect
+    through the library at all, read by the same gate (stop 71; its earlier sets ran no oracle).
+    No effect: ``{}``.
+    """
+    if case.get("family", "nominal") == "second":
+        if case.get("effect", "none") == "none":
+            return {}, "library"
+        return {case["effect"]: {case["param"]: case["value"]}}, "library"
+    eff = (truth.get("vehicle", {}).get("truth", {}) or {}).get("effects") or {}
+    oracle = {k: dict(v) for k, v in eff.items()}
+    if "sensor" in oracle:        # the nominal model carries the measured noise floor
+        oracle["sensor"].update(acc_noise=0.0, disp_noise=0.0)
+    return oracle, "truth"
 
 
 def first_pass_result(case: dict, summ: dict, key: str = "band_refit") -> dict | None:
@@ -541,7 +559,10 @@ def _family_score(rs: list[dict]) -> dict:
 def detectable(r: dict) -> bool:
     """Whether a blind case's truth shows its own effect: the truth effect at its true strength
     passes the ranking's gate (a positive held-out improvement, paired z above ``Z_PAIRED``).
-    Only cases whose truth is our own model carry ``true_paired_z``; others are never detectable."""
+    Cases of our own truck carry the truth's effect as the oracle; the independent truck's
+    (``oracle == "library"``, sets run since stop 71) the library's effect at the truth's
+    strength, which says whether the data show it through the library; cases without
+    ``true_paired_z`` (that truck's older sets) are never detectable."""
     return (r.get("true_paired_z") is not None and (r.get("true_shrink") or 0) > 0
             and r["true_paired_z"] > Z_PAIRED)
 

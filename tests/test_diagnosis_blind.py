@@ -106,3 +106,23 @@ def test_the_oracle_runs_on_the_band_the_reported_pass_ran_on():
     assert reported_nmax({"meta": {"joint_band": kept, "band_refit": refit}}) == [2.5, 5.0]
     assert reported_nmax({"meta": {"joint_band": cut, "band_refit": refit}}) == [2.0, 2.0]
     assert reported_nmax({"meta": {"band_refit": dict(refit, changed=False)}}) is None
+
+
+def test_the_oracle_of_each_truck():
+    """Our truck's oracle is its truth's own effects (a sensor without the noise floor the nominal
+    model carries); the independent truck's is the library effect at the truth's strength (its own
+    effects are its model, not ours), so detectable() can be read for both trucks (stop 71)."""
+    from diagnosis.blind import detectable, oracle_effects
+
+    truth = {"vehicle": {"truth": {"effects": {"sensor": {"cutoff": 12.0, "acc_noise": 0.02}}}}}
+    eff, kind = oracle_effects({"family": "nominal", "effect": "sensor"}, truth)
+    assert kind == "truth" and eff == {"sensor": {"cutoff": 12.0, "acc_noise": 0.0, "disp_noise": 0.0}}
+    assert truth["vehicle"]["truth"]["effects"]["sensor"]["acc_noise"] == 0.02   # not modified
+    second = {"family": "second", "effect": "leaf_friction", "param": "force", "value": 602.3}
+    eff, kind = oracle_effects(second, {"vehicle": {"truth": {"effects": {"anything": {}}}}})
+    assert kind == "library" and eff == {"leaf_friction": {"force": 602.3}}
+    assert oracle_effects(dict(second, effect="none"), {}) == ({}, "library")
+    assert oracle_effects({"family": "nominal", "effect": "none"}, {}) == ({}, "truth")
+    # the gate detectable() applies is the same for both
+    shown = dict(_r(0, "leaf_friction", "unexplained", "none", true_shrink=0.25, z=5.2), oracle="library")
+    assert detectable(shown) and not detectable(dict(shown, true_paired_z=2.9))
