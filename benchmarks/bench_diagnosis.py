@@ -163,7 +163,7 @@ def main(argv=None) -> int:
           f"confident wrong {sc['confident_wrong']}, localisation hits on effect cases "
           f"{sc['localisation_hit_rate_effects']:.2f}, flagged cells on null cases "
           f"{sc['null_flagged_cells']}, mean |pred - true shrink| {sc['shrink_mean_abs_diff']}")
-    print(f"detectable cases (truth passes the noise gate) {sc['n_detectable']}: top-1 "
+    print(f"detectable cases (the truth's effect -- for the independent truck the library's at the true value -- passes the noise gate) {sc['n_detectable']}: top-1 "
           f"{sc['detectable_top1_accuracy']:.2f}; undetectable effect cases answered 'none' "
           f"{sc['undetectable_none_rate']:.2f}")
     print(f"diagnosis wall time: mean {sum(d) / len(d):.1f} s, max {max(d):.1f} s "
