@@ -87,10 +87,12 @@ def _invert_one(runner: str, dataset: str, out: str, kwargs: dict, argv: list) -
                 pass
         return {"dataset": dataset, "run": out, "status": "failed", "error": line,
                 "wall_s": _time.perf_counter() - t0}
+    from inverse.report import class_label
+
     segs = summary.get("segments", [])
     e = summary.get("errors", {})
     return {"dataset": dataset, "run": out, "status": "complete", "error": None,
-            "wall_s": _time.perf_counter() - t0, "classes": [s.get("class") for s in segs],
+            "wall_s": _time.perf_counter() - t0, "classes": [class_label(s) for s in segs],
             "fit_quality": summary.get("fit_quality", {}).get("status"),
             "rms_err": {c: v.get("rms_err") for c, v in e.items() if c.startswith("axle_acc_")}}
 

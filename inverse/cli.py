@@ -131,7 +131,9 @@ def _cmd_invert(args) -> int:
             return f"{c} RMS err {100 * e[c]['rms_err']:+.1f}%"
         ref = summary.get("fit", {}).get("reference_axle", 3)
         errs = ", ".join(err(c) for c in (f"axle_acc_{ref}L", f"axle_acc_{ref}R") if c in e)
-        print(f"wrote {args.out}: K = {len(segs)} segments, classes {' '.join(s['class'] for s in segs)}"
+        from inverse.report import class_label
+
+        print(f"wrote {args.out}: K = {len(segs)} segments, classes {' '.join(class_label(s) for s in segs)}"
               + (f"; {errs} (median [16-84 %] over road realisations)" if errs else
                  f"; no Table 2 headline (axle {ref}'s accelerations were not fitted)")
               + f" ({summary['timing']['total_s']:.1f} s wall)")

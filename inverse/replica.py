@@ -770,6 +770,8 @@ def segment_psd_rows(rep: Replica, time, segments: list, band_m=(0.5, 20.0)) -> 
     replica / fit over ``band_m`` and the segment's own band (``ln_ratio``, [-];
     nan where under 3 Welch bins fall in it).
     """
+    from inverse.report import class_label
+
     from roadlib.metrics import profile_psd
 
     t = np.asarray(time, float)
@@ -792,7 +794,7 @@ def segment_psd_rows(rep: Replica, time, segments: list, band_m=(0.5, 20.0)) -> 
         rows.append({"segment": k + 1, "t_start": float(seg["t_start"]), "t_end": float(seg["t_end"]),
                      "x_start": float(x0), "x_end": float(x1), "n": n, "G": G, "fit": fit,
                      "band": (float(lo), float(hi)), "ln_ratio": lr,
-                     "road_model": seg.get("road_model", "one_slope"), "class": seg.get("class")})
+                     "road_model": seg.get("road_model", "one_slope"), "class": class_label(seg)})
     return rows
 
 

@@ -22,6 +22,30 @@ def table2_channels(axle: int = 3) -> tuple:
 TABLE2_CHANNELS = table2_channels(3)
 
 
+def class_identified(seg: dict) -> bool:
+    """Whether a segment's ISO class is a result: its Gq(n0) identifiable (posterior variance at
+    most ``id_ratio`` of the prior's, :mod:`inverse.sensitivity`); rows without the record count
+    as identified (older summaries)."""
+    ident = seg.get("identifiable")
+    return not (isinstance(ident, dict) and ident.get("Gq_n0") is False)
+
+
+def class_label(seg: dict) -> str:
+    """The class as the tables and the CLI show it: ``"B"``, or ``"(B)"`` where Gq(n0) is not
+    identifiable -- the data barely move the fit from its starting guess (the segmentation's
+    RMS class), so the letter is that guess, not a result (:data:`UNIDENTIFIED_CLASS_NOTE`)."""
+    c = str(seg.get("class", ""))
+    return c if class_identified(seg) else f"({c})"
+
+
+#: the note's sentence on a class in brackets (Table 1, where a segment has one)
+UNIDENTIFIED_CLASS_NOTE = (
+    "A class in brackets: Gq_n0 is not identifiable in that segment (the data leave more than a quarter "
+    "of its prior variance, typically a segment shorter than about 1 s): the fit stays near its starting "
+    "guess, the class the segmentation's RMS suggested, so the letter is not a result; its Gq_n0 interval "
+    "says how little is known.")
+
+
 def table1(segments: list) -> pd.DataFrame:
     """Table 1: fitted spectral parameters per segment.
 
@@ -50,7 +74,7 @@ def table1(segments: list) -> pd.DataFrame:
         ident = s.get("identifiable") or {}
         held = [k for k, v in ident.items() if not v] if isinstance(ident, dict) else []
         rows.append({"segment": i + 1, "t_start_s": round(s["t_start"], 3), "t_end_s": round(s["t_end"], 3),
-                     "proportion_pct": round(100 * s["proportion"], 2), "class": s["class"],
+                     "proportion_pct": round(100 * s["proportion"], 2), "class": class_label(s),
                      "Gq_n0_1e-6m3": round(1e6 * s["Gq_n0"], 2), "w": round(s["w"], 3),
                      "nmin_cpm": round(s["nmin"], 4), "nmax_cpm": round(s["nmax"], 3),
                      "dx_m": s["dx"], "dy_m": s["dy"], "not_identifiable": " ".join(held),
@@ -137,6 +161,8 @@ def table1_note(fit_quality: dict | None = None, road_model: bool = True, segmen
             "the segment's data and its numbers are not a clean result.")
     if any((r or {}).get("unresolved") for r in segments or []):
         note += " " + UNRESOLVED_NOTE
+    if any(not class_identified(r or {}) for r in segments or []):
+        note += " " + UNIDENTIFIED_CLASS_NOTE
     if model_form is not None:
         note += " " + MODEL_FORM_NOTE[model_form]
     if channels is not None:

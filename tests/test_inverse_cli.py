@@ -44,6 +44,8 @@ def test_invert_writes_the_run_and_ignores_truth(short_drive):
     assert len(s["segments"]) == 2
     keys = {"t_start", "t_end", "proportion", "Gq_n0", "w", "nmin", "nmax", "dx", "dy", "class"}
     assert all(keys <= set(seg) for seg in s["segments"])
+    # a class is a result only where Gq(n0) is identifiable (stop 71: Table 1 brackets the others)
+    assert all(seg["class_identified"] == seg["identifiable"]["Gq_n0"] for seg in s["segments"])
     assert sum(seg["proportion"] for seg in s["segments"]) == pytest.approx(1.0)
     assert {"axle_acc_3L", "axle_acc_3R"} <= set(s["errors"])
     assert s["selection"]["n_candidates"] == 3 and len(s["history"]) >= 2

@@ -79,3 +79,21 @@ def test_the_segmentations_resolution_reaches_table1_and_its_note():
     assert list(t["unresolved_3s_level_x"]) == ["0.3-2.5", "0-2.5", ""]
     assert "unresolved_3s_level_x" in table1_note({"status": "clean"}, segments=[row])
     assert "unresolved_3s_level_x" not in table1_note({"status": "clean"}, segments=[dict(row, unresolved=None)])
+
+
+def test_a_class_whose_level_is_not_identified_is_shown_in_brackets():
+    """A segment whose Gq(n0) the data do not identify (a 0.5 s piece of a measured road: the fit
+    stays near its starting guess) is not given a class as a result: Table 1 and the CLI show it in
+    brackets and the note says why; an identified one, and an older row without the record, plain."""
+    from inverse.report import class_identified, class_label, table1, table1_note
+
+    row = {"t_start": 0.0, "t_end": 12.0, "proportion": 1.0, "class": "C", "Gq_n0": 256e-6, "w": 2.0,
+           "nmin": 0.01, "nmax": 5.0, "dx": 0.1, "dy": 0.1,
+           "identifiable": {"Gq_n0": True, "w": True, "nmin": False, "nmax": True}}
+    short = dict(row, t_end=0.5, identifiable={"Gq_n0": False, "w": False, "nmin": False, "nmax": False})
+    old = {k: v for k, v in row.items() if k != "identifiable"}
+    assert [class_label(r) for r in (row, short, old)] == ["C", "(C)", "C"]
+    assert [class_identified(r) for r in (row, short, old)] == [True, False, True]
+    assert list(table1([row, short])["class"]) == ["C", "(C)"]
+    assert "class in brackets" in table1_note({"status": "clean"}, segments=[row, short])
+    assert "class in brackets" not in table1_note({"status": "clean"}, segments=[row, old])
