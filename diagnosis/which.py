@@ -1145,8 +1145,10 @@ def rank_effects_folds(candidates: Sequence[Candidate], fit: Callable, simulate:
     mapper = executor.map if executor is not None else map
     kw = dict(kw, pairs=False)
     gens, batches = [], []
-    for c, h, sd in splits:
+    say = kw.pop("progress", None)
+    for f, (c, h, sd) in enumerate(splits):
         g = _ranking(candidates, fit, simulate, c, h, mapper=mapper, seed=sd,
+                     progress=_fold_progress(say, f, len(splits)),
                      **dict(kw, **((terms or dict)())))
         gens.append(g)
         batches.append(next(g))
@@ -1164,6 +1166,16 @@ def rank_effects_folds(candidates: Sequence[Candidate], fit: Callable, simulate:
         except StopIteration as done:
             out.append(done.value)
     return out
+
+
+def _fold_progress(say: Callable[[str], None] | None, fold: int, n_folds: int):
+    """``say`` with each message of fold ``fold`` (0-based) of ``n_folds`` marked at its end
+    ("[fold 1 of 2]"), so the two blocks of candidate lines a user sees say which is which; the
+    message itself keeps its form (the CLI's bar counts "calibrating N candidates" and
+    "  NAME: held-out gap" lines).  One fold, or no ``say``: unchanged."""
+    if say is None or n_folds <= 1:
+        return say
+    return lambda m: say(f"{m} [fold {fold + 1} of {n_folds}]")
 
 
 def _ranking(candidates: Sequence[Candidate], fit: Callable, simulate: Callable,

@@ -1,4 +1,6 @@
 """Effect ranking on held-out data (diagnosis.which) with the toy model's candidate effects."""
+import re
+
 import numpy as np
 import pytest
 
@@ -592,10 +594,19 @@ def test_folds_in_one_batch_are_the_folds_one_after_the_other():
     kw = dict(n_seeds=3, n_null=3, grid=3, refine=3, pairs=False)
     one = [rank_effects(toy.TOY_CANDIDATES, toy.fit, toy.simulate, c, h, seed=sd, **kw)
            for c, h, sd in ((calib, held, 1), (held, calib, 2))]
+    said = []
     with ThreadPoolExecutor(2) as ex:
         both = rank_effects_folds(toy.TOY_CANDIDATES, toy.fit, toy.simulate,
-                                  [(calib, held, 1), (held, calib, 2)], executor=ex, **kw)
+                                  [(calib, held, 1), (held, calib, 2)], executor=ex,
+                                  progress=said.append, **kw)
     assert len(both) == 2
+    # each fold's lines say which fold they are (a user sees two blocks of candidate lines), in
+    # the form the progress bar of diagnosis/cli.py counts (its step pattern, written out here)
+    n = len(toy.TOY_CANDIDATES)
+    for f in (1, 2):
+        assert f"calibrating {n} candidates [fold {f} of 2]" in said
+        lines = [m for m in said if m.endswith(f"[fold {f} of 2]") and ": held-out gap" in m]
+        assert len(lines) == n and all(re.search(r"^\s+\S+: held-out gap", m) for m in lines)
     for a, b in zip(one, both):
         assert (a.verdict, a.confidence) == (b.verdict, b.confidence)
         assert [e.effect for e in a.entries] == [e.effect for e in b.entries]
