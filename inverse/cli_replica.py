@@ -107,6 +107,8 @@ def _cmd_replica(args) -> int:
     for n in summary["linear_model"]["notes"]:
         if "statistically linearised" in n:
             print(f"note: {n}")
+        elif n.startswith("WARNING: "):
+            print(f"warning: {n[len('WARNING: '):]}")
     left = summary["linear_model"]["effects_left_out"]
     if left:
         print(f"note: nonlinear effect(s) {', '.join(left)} left out of the linear model")

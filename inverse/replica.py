@@ -678,7 +678,7 @@ def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, d
 VELOCITY_LOWPASS_HZ = 25.0
 
 
-def replica_linear_model(vehicle, effects, channels: dict, fs: float) -> tuple:
+def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float = 0.0) -> tuple:
     """The linear model of the replica with the given effects.
 
     Linear effects enter as they are.  ``leaf_friction`` (nonlinear) enters by
@@ -691,6 +691,9 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float) -> tuple:
     the RMS over the leaf-spring stations of the measured suspension velocity
     (derivative of ``susp_disp_*``, low-passed at :data:`VELOCITY_LOWPASS_HZ`).  Other
     nonlinear effects (bump stops, damper asymmetry) are left out, as in the linear fit.
+    One damper serves the whole drive; where the drive's suspension velocity varies so much
+    that it is far too soft on a stretch, a note says where (:func:`friction_block_spread`;
+    ``t0``: the record time of the first sample, for those times).
 
     Returns
     -------
@@ -718,8 +721,55 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float) -> tuple:
             keep["leaf_friction"] = {"force": c_eq * p["velocity"], "velocity": p["velocity"]}   # F'/v0 = c_eq
             notes.append(f"leaf_friction {p['force']:.0f} N statistically linearised: suspension velocity "
                          f"RMS {s * 1e3:.0f} mm/s -> damping {c_eq:.0f} N s/m per spring")
+            spread = friction_block_spread(vel, fs, s, t0)
+            if spread is not None:
+                notes.append(spread)
     left = sorted(set(nonlinear) - set(keep))
     return linear_model(vp, "rigid", effects=keep or None), left, notes   # applied in the effects' own order
+
+
+#: blocks [s] over which :func:`friction_block_spread` measures the suspension velocity
+FRICTION_BLOCK_S = 5.0
+#: a block whose equivalent friction damper would be this many times the drive's gets a note.
+#: Why 3: on the embedded drive (results/replica/20261201-smooth-segment/) the class A segment's
+#: damper would be 9.1x the drive's and its replica came out 5-8x too smooth at 0.5-2 m (ln -1.4 to
+#: -2.1); the C segment's, 1.3x, only ln -0.1 to -0.4; the same stretch replicated alone, with its
+#: own damper, within ln 0.3 at every band.  3 sits between what did no harm and what did.
+FRICTION_BLOCK_RATIO = 3.0
+
+
+def friction_block_spread(vel, fs: float, s_drive: float, t0: float = 0.0) -> str | None:
+    """A warning where one statistically linearised friction damper is far too soft for part of
+    the drive, else None.
+
+    ``vel``: the leaf-spring stations' suspension velocities [m/s] as
+    :func:`replica_linear_model` computes them; ``s_drive``: their RMS over the drive.  Over
+    blocks of :data:`FRICTION_BLOCK_S` the damper c_eq ~ 1 / s would be s_drive / s_block times
+    the drive's; blocks where that exceeds :data:`FRICTION_BLOCK_RATIO` are named with their record
+    times: there the friction nearly locks the springs, the linear model takes them for soft, and the
+    replica reads the small strokes as a smoother road."""
+    n = int(round(FRICTION_BLOCK_S * fs))
+    m = min(len(v) for v in vel)
+    if n < 2 or m < 2 * n:
+        return None
+    k = m // n
+    s_blk = np.sqrt(np.mean([np.mean(np.asarray(v[:k * n]).reshape(k, n) ** 2, axis=1) for v in vel], axis=0))
+    ratio = s_drive / np.maximum(s_blk, 1e-12)
+    stiff = np.flatnonzero(ratio > FRICTION_BLOCK_RATIO)
+    if stiff.size == 0:
+        return None
+    spans = ", ".join(f"{t0 + i * FRICTION_BLOCK_S:.0f}-{t0 + (i + 1) * FRICTION_BLOCK_S:.0f} s" for i in stiff)
+
+    def span(a, b, fmt="{:.0f}"):
+        lo, hi = fmt.format(a), fmt.format(b)
+        return lo if lo == hi else f"{lo}-{hi}"
+    return (f"WARNING: one friction damper serves the whole drive, but on {spans} the suspension moves at "
+            f"{span(1e3 * float(s_blk[stiff].min()), 1e3 * float(s_blk[stiff].max()))} mm/s RMS against "
+            f"{1e3 * s_drive:.0f} mm/s for the drive: there the friction nearly locks the springs (a damper "
+            f"{span(float(ratio[stiff].min()), float(ratio[stiff].max()))} times stiffer would fit), so the "
+            f"replica there is too smooth at short wavelengths (embedded drive: 5-8x in PSD at 0.5-2 m). "
+            f"Replicate such a stretch alone (eroad data cut --window T0 T1, then eroad replica on it) "
+            f"-- docs/replica.md")
 
 
 # --------------------------------------------------------------------------- scoring helpers
@@ -971,7 +1021,8 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout="auto", fo
     require_road_record(drive, "eroad replica")   # the road methods run in distance
     holdout, holdout_note = _holdout_axle(holdout, names)
     chans = {c: drive.channels[c].to_numpy(float) for c in names}
-    lm, left_out, lin_notes = replica_linear_model(drive.vehicle, effects, chans, drive.sample_rate_hz)
+    lm, left_out, lin_notes = replica_linear_model(drive.vehicle, effects, chans, drive.sample_rate_hz,
+                                                   t0=float(drive.time[0]))
     missing = [c for c in names if c not in lm.channel_names]
     if missing:
         raise EroadInputError(f"{drive.path}: channel(s) {', '.join(missing)} have no counterpart in "

@@ -224,8 +224,17 @@ def _manifest(run: Path) -> list:
     return manifest_rows(run, [(item, f"{step}/{pattern}", code) for item, step, pattern, code in MANIFEST])
 
 
+def _replica_warnings(run: Path) -> list:
+    """The replica's warnings (its linear model's notes that start "WARNING: "), for the manifest."""
+    p = run / "replica" / "summary.json"
+    if not p.is_file():
+        return []
+    notes = (json.loads(p.read_text()).get("linear_model") or {}).get("notes") or []
+    return [n[len("WARNING: "):] for n in notes if str(n).startswith("WARNING: ")]
+
+
 def _manifest_md(rows: list, timings: dict, fit_quality: dict | None = None,
-                 diagnosis_s: float | None = None) -> str:
+                 diagnosis_s: float | None = None, replica_warnings=()) -> str:
     lines = ["# eroad reproduce: manifest", "",
              "Each paper item, the file(s) that show it (relative to this folder) and the "
              "code that made them.", ""]
@@ -234,6 +243,8 @@ def _manifest_md(rows: list, timings: dict, fit_quality: dict | None = None,
                   "shown, but they are not a clean result.", ""]
     elif fit_quality:
         lines += ["Inversion: every segment passes the fit-quality gate.", ""]
+    for w in replica_warnings:
+        lines += [f"**Road replica:** {w}", ""]
     lines += ["| paper item | file(s) | code |", "|---|---|---|"]
     for r in rows:
         files = "<br>".join(f"[{f}]({f})" for f in r["files"]) or "**missing**"
@@ -312,7 +323,7 @@ def reproduce(out, *, quick: bool = False, workers: int = 2, force: bool = False
         fq = results.get("invert", {}).get("fit_quality") if isinstance(results.get("invert"), dict) else None
         dg = tmp / "invert" / "diagnose" / "run.json"
         dg_s = json.loads(dg.read_text()).get("wall_s") if dg.is_file() else None
-        (tmp / "manifest.md").write_text(_manifest_md(rows, timings, fq, dg_s))
+        (tmp / "manifest.md").write_text(_manifest_md(rows, timings, fq, dg_s, _replica_warnings(tmp)))
         target = out if record["status"] == "complete" else out.with_name(f"{out.name}.failed-{os.getpid()}")
         if target.exists():
             target.rmdir()  # empty (checked above)

@@ -349,3 +349,30 @@ def test_segment_psd_against_an_inversion_agrees_on_a_known_profile():
            "road_model_fit": {"two_slope": {"Gq_n0_low_line": 1e-4}}}
     n = np.array([0.05, 0.3, 2.0])
     assert np.allclose(inversion_segment_psd(two, n), two_slope_psd(n, 1e-4, 2.5, 1.5, 0.3))
+
+
+def test_one_friction_damper_too_soft_for_a_quiet_stretch_is_said():
+    """The replica's statistically linearised leaf friction has one damper for the whole drive; a
+    5 s block whose suspension moves at a third or less of the drive's RMS (its damper would be 3x
+    stiffer or more) is named with its record times (stop 71: the embedded drive's class A segment,
+    13 mm/s against 120 mm/s, came out 5-8x too smooth at 0.5-2 m); a drive without one gets no note."""
+    from inverse.replica import FRICTION_BLOCK_RATIO, friction_block_spread
+
+    fs = 100.0
+    rng = np.random.default_rng(0)
+    loud = 0.12 * rng.standard_normal(int(20 * fs))
+    quiet = 0.012 * rng.standard_normal(int(10 * fs))
+    vel = [np.concatenate([quiet, loud]), np.concatenate([quiet, loud])]
+    s = float(np.sqrt(np.mean([np.mean(v ** 2) for v in vel])))
+    w = friction_block_spread(vel, fs, s, t0=460.0)
+    assert w is not None and w.startswith("WARNING: ")
+    assert "460-465 s, 465-470 s" in w and "470-475" not in w and "eroad data cut --window" in w
+    assert friction_block_spread([loud, loud], fs, float(np.sqrt(np.mean(loud ** 2)))) is None
+    # the threshold: a block at 1/2.5 of the drive's RMS passes, one at 1/3.5 is named
+    assert FRICTION_BLOCK_RATIO == 3.0
+    for f, named in ((2.5, False), (3.5, True)):
+        base = np.sign(np.sin(np.arange(int(30 * fs))))          # RMS 1 exactly per block
+        v = base.copy()
+        v[:int(5 * fs)] /= f
+        got = friction_block_spread([v], fs, 1.0)
+        assert (got is not None) == named, f

@@ -227,3 +227,21 @@ def test_copied_diagnosis_records_the_dataset_relative_to_its_new_folder(tmp_pat
     assert "- dataset: `../dataset`" in (dst / "report.md").read_text()
     assert (dst / json.loads((dst / "summary.json").read_text())["meta"]["dataset"]).resolve() \
         == (run / "dataset").resolve()
+
+
+def test_the_manifest_carries_the_replicas_warnings(tmp_path):
+    """A warning of the replica's linear model (a friction damper too soft for a quiet stretch) is
+    put at the top of the manifest, where a user of `eroad reproduce` starts (stop 71)."""
+    from studies.reproduce import _manifest_md, _replica_warnings
+
+    assert _replica_warnings(tmp_path) == []
+    (tmp_path / "replica").mkdir()
+    notes = ["leaf_friction 2221 N statistically linearised: ...",
+             "WARNING: one friction damper serves the whole drive, but on 460-465 s ..."]
+    (tmp_path / "replica" / "summary.json").write_text(json.dumps({"linear_model": {"notes": notes}}))
+    ws = _replica_warnings(tmp_path)
+    assert ws == ["one friction damper serves the whole drive, but on 460-465 s ..."]
+    md = _manifest_md([], {}, None, None, ws)
+    assert "**Road replica:** one friction damper serves the whole drive" in md
+    assert md.index("Road replica:") < md.index("| paper item |")
+    assert "Road replica:" not in _manifest_md([], {}, None, None)
