@@ -39,7 +39,7 @@ def main(cache, out, seeds):
         nb = int(len(d.time) // round(FRICTION_BLOCK_S * d.sample_rate_hz))
         for b in range(nb):
             ta, tb = d.time[0] + b * FRICTION_BLOCK_S, d.time[0] + (b + 1) * FRICTION_BLOCK_S
-            xa, xb = np.interp([ta, tb], d.time, s_t) + rep.x[0]
+            xa, xb = np.interp([ta, tb], d.time, s_t)      # x is measured from axle 1 at the first sample
             sel = (rep.x >= xa) & (rep.x < xb) & rep.covered
             if sel.sum() < 64:
                 continue
