@@ -104,11 +104,13 @@ def _cmd_replica(args) -> int:
     print(line + f" ({summary['timing']['total_s']:.0f} s wall)")
     if "closed_loop" in summary:
         print(f"closed loop: {summary['closed_loop']['reason']}")
+    from inverse.replica import note_warnings
+
     for n in summary["linear_model"]["notes"]:
         if "statistically linearised" in n:
             print(f"note: {n}")
-        elif n.startswith("WARNING: "):
-            print(f"warning: {n[len('WARNING: '):]}")
+    for w in note_warnings(summary["linear_model"]["notes"]):
+        print(f"warning: {w}")
     left = summary["linear_model"]["effects_left_out"]
     if left:
         print(f"note: nonlinear effect(s) {', '.join(left)} left out of the linear model")

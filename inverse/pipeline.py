@@ -214,6 +214,7 @@ class Inversion:
             fitted level or waviness sitting on a bound of the fit (:func:`at_bounds`);
             ``unresolved`` the segmentation's resolution (:func:`unresolved_row`).
         """
+        from inverse.report import class_identified
         from inverse.uncertainty import fit_quality, honest_sd, interval90
 
         rows = []
@@ -234,7 +235,7 @@ class Inversion:
             rows.append({"t_start": float(tb[k]), "t_end": float(tb[k + 1]), "proportion": float(prop[k]),
                          "Gq_n0": d["Gq_n0"], "w": d["w"], "nmin": d["nmin"], "nmax": d["nmax"],
                          "dx": d["dx"], "dy": d["dy"], "class": d["class"],
-                         "class_identified": bool(d["identifiable"].get("Gq_n0", True)),
+                         "class_identified": class_identified(d),
                          "initial_class": self.segmentation.classes[k],
                          "identifiable": d["identifiable"],
                          "sd": {key: v for key, v in sd.items() if key != "ln_G_n_best"},

@@ -728,6 +728,17 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
     return linear_model(vp, "rigid", effects=keep or None), left, notes   # applied in the effects' own order
 
 
+#: the prefix of a linear-model note that is a warning (:func:`note_warnings` finds them)
+WARNING_PREFIX = "WARNING: "
+
+
+def note_warnings(notes) -> list:
+    """The warnings among the replica's linear-model notes (``summary["linear_model"]["notes"]``),
+    without their prefix: what ``eroad replica`` prints as warnings and ``eroad reproduce`` puts
+    at the top of its manifest."""
+    return [str(n)[len(WARNING_PREFIX):] for n in notes or [] if str(n).startswith(WARNING_PREFIX)]
+
+
 #: blocks [s] over which :func:`friction_block_spread` measures the suspension velocity
 FRICTION_BLOCK_S = 5.0
 #: a block whose equivalent friction damper would be this many times the drive's gets a note.
@@ -760,10 +771,10 @@ def friction_block_spread(vel, fs: float, s_drive: float, t0: float = 0.0) -> st
         return None
     spans = ", ".join(f"{t0 + i * FRICTION_BLOCK_S:.0f}-{t0 + (i + 1) * FRICTION_BLOCK_S:.0f} s" for i in stiff)
 
-    def span(a, b, fmt="{:.0f}"):
-        lo, hi = fmt.format(a), fmt.format(b)
+    def span(a, b):
+        lo, hi = f"{a:.0f}", f"{b:.0f}"
         return lo if lo == hi else f"{lo}-{hi}"
-    return (f"WARNING: one friction damper serves the whole drive, but on {spans} the suspension moves at "
+    return (f"{WARNING_PREFIX}one friction damper serves the whole drive, but on {spans} the suspension moves at "
             f"{span(1e3 * float(s_blk[stiff].min()), 1e3 * float(s_blk[stiff].max()))} mm/s RMS against "
             f"{1e3 * s_drive:.0f} mm/s for the drive: there the friction nearly locks the springs (a damper "
             f"{span(float(ratio[stiff].min()), float(ratio[stiff].max()))} times stiffer would fit), so the "

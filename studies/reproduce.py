@@ -225,12 +225,13 @@ def _manifest(run: Path) -> list:
 
 
 def _replica_warnings(run: Path) -> list:
-    """The replica's warnings (its linear model's notes that start "WARNING: "), for the manifest."""
+    """The replica's warnings (:func:`inverse.replica.note_warnings` of its summary), for the manifest."""
     p = run / "replica" / "summary.json"
     if not p.is_file():
         return []
-    notes = (json.loads(p.read_text()).get("linear_model") or {}).get("notes") or []
-    return [n[len("WARNING: "):] for n in notes if str(n).startswith("WARNING: ")]
+    from inverse.replica import note_warnings
+
+    return note_warnings((json.loads(p.read_text()).get("linear_model") or {}).get("notes"))
 
 
 def _manifest_md(rows: list, timings: dict, fit_quality: dict | None = None,
