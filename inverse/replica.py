@@ -138,7 +138,6 @@ class ReplicaOperator:
         sf -= sf[n_run * sub]                           # s = 0 at the first sample
         self.s_record = sf[self.i_out]
         xs = np.array([c["x"] for c in lm.contacts], float)
-        sides = [0 if c["side"] == "L" else 1 for c in lm.contacts]
         self.blocks, blocks_of = unknown_blocks(lm.contacts, lines)
         self.lines, self.blocks_of = lines, blocks_of
         j0 = math.floor((sf[0] + xs.min()) / dx) - 2
@@ -166,7 +165,20 @@ class ReplicaOperator:
         self.Mu = sps.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                                  shape=(2 * nc * nf, self.n_blocks * N))
         self.nf, self.nc = nf, nc
-        # continuous state space x = [q, q'], u = [z_r, z_r'] -> outputs
+        # continuous state space x = [q, q'], u = [z_r, z_r'] -> outputs; one piece per model of a
+        # BlockModel (the leaf friction's damper along the drive), else one piece
+        sched = getattr(lm, "pieces", None) or [(0, lm)]
+        starts = [0] + [n_run * sub + int(k) * sub for k, _ in sched[1:]]
+        self.pieces = [self._discretised(m, h, a, b)
+                       for (_, m), a, b in zip(sched, starts, starts[1:] + [nf])]
+        self.Dd = self.pieces[0]["Dd"]
+
+    def _discretised(self, lm, h: float, a: int, b: int) -> dict:
+        """One piece [a, b) of the fine grid: ``lm`` discretised (first-order hold) and diagonalised.
+        Its modal coordinates xi (one per real mode, one per conjugate pair with weight 2) give the
+        state ``x = Re(W xi)`` handed to the next piece, which takes ``xi' = T x`` (the hold's
+        state is carried as it is: its difference between two pieces is O(h^2) of the damper's
+        change times the road input)."""
         A, B = lm.state_space()
         C, Dm = lm.output_matrices(self.channels, A, B)
         Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, Dm), h, method="foh")
@@ -177,10 +189,15 @@ class ReplicaOperator:
         real = np.abs(lam.imag) <= 1e-12 * np.abs(lam)
         sel = keep | real
         wt = np.where(real[sel], 1.0, 2.0)
-        self.lam = lam[sel]
-        self.Bm = Vi[sel] @ Bd
-        self.Cm = (Cd @ V[:, sel]) * wt[None, :]
-        self.Dd = Dd
+        out_idx = np.flatnonzero((self.i_out >= a) & (self.i_out < b))
+        return {"a": a, "b": b, "lam": lam[sel], "Bm": Vi[sel] @ Bd, "Cm": (Cd @ V[:, sel]) * wt[None, :],
+                "Dd": Dd, "W": V[:, sel] * wt[None, :], "T": Vi[sel], "k": out_idx,
+                "f": self.i_out[out_idx] - a}
+
+    @property
+    def lam(self):
+        """Modal poles of the (first) piece."""
+        return self.pieces[0]["lam"]
 
     @property
     def n_unknowns(self) -> int:
@@ -198,30 +215,45 @@ class ReplicaOperator:
             out = [(blk["side"], blk["y"], u[b].copy()) for b, blk in enumerate(self.blocks)]
         return out
 
-    def _modal(self, g: np.ndarray) -> np.ndarray:
-        out = np.empty_like(g)
-        for m, lm_ in enumerate(self.lam):
-            out[m] = lfilter([0.0, 1.0], [1.0, -lm_], g[m])
-        return out
-
     def forward(self, z: np.ndarray) -> np.ndarray:
         """Channels (n_channels, T) [channel units] for profiles ``z`` = [z_L, z_R] (2N,) [m]."""
         u = (self.Mu @ np.asarray(z, float)).reshape(2 * self.nc, self.nf)
-        g = self.Bm.real @ u + 1j * (self.Bm.imag @ u)
-        xi = self._modal(g)[:, self.i_out]
-        return self.Cm.real @ xi.real - self.Cm.imag @ xi.imag + self.Dd @ u[:, self.i_out]
+        Y = np.empty((len(self.channels), self.i_out.size))
+        x = None                                   # the state handed on (at rest before the run-in)
+        for p in self.pieces:
+            up = u[:, p["a"]:p["b"]]
+            g = p["Bm"].real @ up + 1j * (p["Bm"].imag @ up)
+            x0 = p["T"] @ x if x is not None else np.zeros(p["lam"].size, complex)
+            xi = np.empty_like(g)
+            xend = np.empty(p["lam"].size, complex)
+            for m, lm_ in enumerate(p["lam"]):
+                xi[m], zf = lfilter([0.0, 1.0], [1.0, -lm_], g[m], zi=[x0[m]])
+                xend[m] = zf[0]
+            xo = xi[:, p["f"]]
+            Y[:, p["k"]] = (p["Cm"].real @ xo.real - p["Cm"].imag @ xo.imag + p["Dd"] @ up[:, p["f"]])
+            x = (p["W"] @ xend).real
+        return Y
 
     def adjoint(self, Y: np.ndarray) -> np.ndarray:
         """Adjoint of :meth:`forward`: (n_channels, T) -> (2N,)."""
         Y = np.asarray(Y, float)
         ub = np.zeros((2 * self.nc, self.nf))
-        ub[:, self.i_out] = self.Dd.T @ Y
-        s = np.zeros((self.lam.size, self.nf), complex)
-        s[:, self.i_out] = self.Cm.conj().T @ Y
-        eta = np.empty_like(s)
-        for m, lm_ in enumerate(self.lam):
-            eta[m] = lfilter([0.0, 1.0], [1.0, -np.conj(lm_)], s[m, ::-1])[::-1]
-        ub += self.Bm.real.T @ eta.real + self.Bm.imag.T @ eta.imag
+        sig = None                                 # adjoint of the state handed on
+        for p in reversed(self.pieces):
+            a, b = p["a"], p["b"]
+            Yp = Y[:, p["k"]]
+            ub[:, a + p["f"]] += p["Dd"].T @ Yp
+            s = np.zeros((p["lam"].size, b - a), complex)
+            s[:, p["f"]] = p["Cm"].conj().T @ Yp
+            zeta = p["W"].conj().T @ sig if sig is not None else np.zeros(p["lam"].size, complex)
+            eta = np.empty_like(s)
+            lam0 = np.empty(p["lam"].size, complex)
+            for m, lm_ in enumerate(p["lam"]):
+                e, zf = lfilter([0.0, 1.0], [1.0, -np.conj(lm_)], s[m, ::-1], zi=[zeta[m]])
+                eta[m] = e[::-1]
+                lam0[m] = zf[0]
+            ub[:, a:b] += p["Bm"].real.T @ eta.real + p["Bm"].imag.T @ eta.imag
+            sig = (p["T"].conj().T @ lam0).real
         return self.Mu.T @ ub.ravel()
 
     def profile_input(self, z_left, z_right=None) -> tuple:
@@ -678,7 +710,67 @@ def reconstruct(lm, time, speed, channels: dict, *, noise: dict | None = None, d
 VELOCITY_LOWPASS_HZ = 25.0
 
 
-def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float = 0.0) -> tuple:
+class BlockModel:
+    """A linear model whose leaf-friction damper changes along the drive.
+
+    ``pieces``: ``[(k0, LinearModel), ...]``, the record sample at which each model takes over
+    (the first at 0; the first also serves the run-in); ``reference``: the model for what needs one
+    linear model (identified band, EM's posterior variance, CG's preconditioner, contacts, outputs),
+    which every other attribute is read from; ``damping``: the equivalent damper of each piece
+    [N s/m per spring]; ``speed_rms``: its suspension velocity RMS [m/s].
+    :class:`ReplicaOperator` switches between the pieces' state spaces, carrying the state.
+    """
+
+    def __init__(self, reference, pieces, damping, speed_rms):
+        self.reference = reference
+        self.pieces = list(pieces)
+        self.damping = list(damping)
+        self.speed_rms = list(speed_rms)
+
+    def __getattr__(self, name):
+        if name in ("reference", "pieces", "damping", "speed_rms"):   # not set yet (copy, unpickle)
+            raise AttributeError(name)
+        return getattr(self.reference, name)
+
+
+#: blocks [s] over which the leaf friction is linearised (:func:`replica_linear_model`)
+FRICTION_BLOCK_S = 5.0
+#: neighbouring blocks whose equivalent dampers round to the same power of this factor share one
+#: linear model (a damper within +-9 % of a block's own changes the replica by far less than the
+#: noise; fewer pieces, fewer model switches)
+FRICTION_LEVEL_STEP = 2.0 ** 0.25
+
+
+def statistical_damper(force: float, velocity: float, s: float) -> float:
+    """Equivalent viscous damper [N s/m] of a Coulomb force ``force`` for a Gaussian velocity of
+    sd ``s`` (c = F sqrt(2/pi) / s, Roberts & Spanos), no stiffer than the smoothed force's own
+    slope at rest ``force / velocity``."""
+    return force / max(velocity, s * math.sqrt(math.pi / 2.0))
+
+
+def friction_blocks(vel, fs: float) -> list:
+    """Sample ranges ``(k0, k1)`` of :data:`FRICTION_BLOCK_S` blocks joined where their dampers
+    share a level (:data:`FRICTION_LEVEL_STEP`), from the leaf-spring stations' suspension velocities
+    ``vel`` [m/s]; the last part-block joins the last block."""
+    m = min(len(v) for v in vel)
+    n = int(round(FRICTION_BLOCK_S * fs))
+    if n < 2 or m < 2 * n:
+        return [(0, m)]
+    edges = [i * n for i in range(m // n)] + [m]
+    rms = [math.sqrt(np.mean([np.mean(np.asarray(v[k0:k1]) ** 2) for v in vel]))
+           for k0, k1 in zip(edges, edges[1:])]
+    level = [round(-math.log(max(r, 1e-12)) / math.log(FRICTION_LEVEL_STEP)) for r in rms]
+    out = []
+    for (k0, k1), lv in zip(zip(edges, edges[1:]), level):
+        if out and out[-1][2] == lv:
+            out[-1][1] = k1
+        else:
+            out.append([k0, k1, lv])
+    return [(k0, k1) for k0, k1, _ in out]
+
+
+def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float = 0.0,
+                         per_block: bool = True) -> tuple:
     """The linear model of the replica with the given effects.
 
     Linear effects enter as they are.  ``leaf_friction`` (nonlinear) enters by
@@ -689,15 +781,23 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
     Linearization).  The effect's smoothed force F tanh(v / v0), linearised at rest as
     the linear model does, is a damper F / v0; so the force handed to it is c_eq v0, with s
     the RMS over the leaf-spring stations of the measured suspension velocity
-    (derivative of ``susp_disp_*``, low-passed at :data:`VELOCITY_LOWPASS_HZ`).  Other
-    nonlinear effects (bump stops, damper asymmetry) are left out, as in the linear fit.
-    One damper serves the whole drive; where the drive's suspension velocity varies so much
-    that it is far too soft on a stretch, a note says where (:func:`friction_block_spread`;
-    ``t0``: the record time of the first sample, for those times).
+    (derivative of ``susp_disp_*``, low-passed at :data:`VELOCITY_LOWPASS_HZ`).
+
+    ``per_block`` (default): s, and so the damper, is taken per :data:`FRICTION_BLOCK_S` block
+    of the record (:func:`friction_blocks`) and the model returned is a :class:`BlockModel` that
+    switches between them: friction that nearly locks the springs on a smooth stretch and slips
+    on a rough one is not one damper (one damper for the whole drive made the embedded drive's
+    class A segment 5-8x too smooth at 0.5-2 m, results/replica/20261201-smooth-segment/;
+    per block: results/replica/20261201-block-linearisation/).  ``per_block=False``: one damper
+    for the whole drive, with a warning where a block would need one more than
+    ``FRICTION_BLOCK_RATIO`` times stiffer (:func:`friction_block_spread`; ``t0``: the record
+    time of the first sample, for the notes' times).  Other nonlinear effects (bump stops,
+    damper asymmetry) are left out, as in the linear fit.
 
     Returns
     -------
-    (LinearModel, left_out, notes) : the model, the effects left out, lines for the report.
+    (model, left_out, notes) : the model (a LinearModel, or a BlockModel), the effects left out,
+    lines for the report.
     """
     from scipy.signal import butter, sosfiltfilt
 
@@ -708,6 +808,7 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
     vp = load_vehicle(vehicle)
     keep, nonlinear = split_linear_effects(effects)
     notes = []
+    left = sorted(set(nonlinear) - {"leaf_friction"} - set(keep))     # friction, where linearised below
     if "leaf_friction" in nonlinear and nonlinear["leaf_friction"]["force"] > 0:
         leaf_axles = {i + 1 for i, a in enumerate(vp.axles) if getattr(a, "spring_type", "") == "leaf"}
         disp = [np.asarray(y, float) for c, y in channels.items()
@@ -715,15 +816,33 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
         if disp:
             sos = butter(4, min(VELOCITY_LOWPASS_HZ, 0.4 * fs), fs=fs, output="sos")
             vel = [np.gradient(sosfiltfilt(sos, d - d.mean())) * fs for d in disp]
-            s = float(np.sqrt(np.mean([np.mean(v ** 2) for v in vel])))
             p = dict(nonlinear["leaf_friction"])
-            c_eq = p["force"] / max(p["velocity"], s * math.sqrt(math.pi / 2.0))
-            keep["leaf_friction"] = {"force": c_eq * p["velocity"], "velocity": p["velocity"]}   # F'/v0 = c_eq
+
+            def model_at(s):
+                c = statistical_damper(p["force"], p["velocity"], s)
+                eff = dict(keep, leaf_friction={"force": c * p["velocity"], "velocity": p["velocity"]})
+                return linear_model(vp, "rigid", effects=eff), c     # F'/v0 = c_eq
+
+            s = float(np.sqrt(np.mean([np.mean(v ** 2) for v in vel])))
+            ref, c_ref = model_at(s)
+            blocks = friction_blocks(vel, fs) if per_block else [(0, len(vel[0]))]
+            if len(blocks) > 1:
+                rms = [float(np.sqrt(np.mean([np.mean(v[k0:k1] ** 2) for v in vel]))) for k0, k1 in blocks]
+                made = [model_at(r) for r in rms]
+                cs = [c for _, c in made]
+                notes.append(f"leaf_friction {p['force']:.0f} N statistically linearised per "
+                             f"{FRICTION_BLOCK_S:.0f} s block: suspension velocity RMS {1e3 * min(rms):.0f}-"
+                             f"{1e3 * max(rms):.0f} mm/s -> damping {min(cs):.0f}-{max(cs):.0f} N s/m per "
+                             f"spring in {len(blocks)} pieces (one damper for the drive: {c_ref:.0f})")
+                return (BlockModel(ref, [(k0, m) for (k0, _), (m, _) in zip(blocks, made)], cs, rms),
+                        left, notes)
             notes.append(f"leaf_friction {p['force']:.0f} N statistically linearised: suspension velocity "
-                         f"RMS {s * 1e3:.0f} mm/s -> damping {c_eq:.0f} N s/m per spring")
-            spread = friction_block_spread(vel, fs, s, t0)
-            if spread is not None:
-                notes.append(spread)
+                         f"RMS {s * 1e3:.0f} mm/s -> damping {c_ref:.0f} N s/m per spring")
+            if not per_block:
+                spread = friction_block_spread(vel, fs, s, t0)
+                if spread is not None:
+                    notes.append(spread)
+            return ref, left, notes
     left = sorted(set(nonlinear) - set(keep))
     return linear_model(vp, "rigid", effects=keep or None), left, notes   # applied in the effects' own order
 
@@ -739,8 +858,6 @@ def note_warnings(notes) -> list:
     return [str(n)[len(WARNING_PREFIX):] for n in notes or [] if str(n).startswith(WARNING_PREFIX)]
 
 
-#: blocks [s] over which :func:`friction_block_spread` measures the suspension velocity
-FRICTION_BLOCK_S = 5.0
 #: a block whose equivalent friction damper would be this many times the drive's gets a note.
 #: Why 3: on the embedded drive (results/replica/20261201-smooth-segment/) the class A segment's
 #: damper would be 9.1x the drive's and its replica came out 5-8x too smooth at 0.5-2 m (ln -1.4 to
