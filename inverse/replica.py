@@ -735,9 +735,9 @@ class BlockModel:
 
 #: blocks [s] over which the leaf friction is linearised (:func:`replica_linear_model`)
 FRICTION_BLOCK_S = 5.0
-#: neighbouring blocks whose equivalent dampers round to the same power of this factor share one
-#: linear model (a damper within +-9 % of a block's own changes the replica by far less than the
-#: noise; fewer pieces, fewer model switches)
+#: neighbouring blocks whose equivalent dampers lie within this factor of each other share one
+#: linear model, linearised on their joint velocity RMS (a damper within ~+-9 % of a block's own
+#: changes the replica far less than the noise does; fewer pieces, fewer model switches)
 FRICTION_LEVEL_STEP = 2.0 ** 0.25
 
 
@@ -749,9 +749,10 @@ def statistical_damper(force: float, velocity: float, s: float) -> float:
 
 
 def friction_blocks(vel, fs: float) -> list:
-    """Sample ranges ``(k0, k1)`` of :data:`FRICTION_BLOCK_S` blocks joined where their dampers
-    share a level (:data:`FRICTION_LEVEL_STEP`), from the leaf-spring stations' suspension velocities
-    ``vel`` [m/s]; the last part-block joins the last block."""
+    """Sample ranges ``(k0, k1)`` of :data:`FRICTION_BLOCK_S` blocks, neighbours joined while their
+    velocity RMS (so their dampers) stay within :data:`FRICTION_LEVEL_STEP` of each other, from the
+    leaf-spring stations' suspension velocities ``vel`` [m/s]; the last part-block joins the last
+    block."""
     m = min(len(v) for v in vel)
     n = int(round(FRICTION_BLOCK_S * fs))
     if n < 2 or m < 2 * n:
@@ -759,14 +760,13 @@ def friction_blocks(vel, fs: float) -> list:
     edges = [i * n for i in range(m // n)] + [m]
     rms = [math.sqrt(np.mean([np.mean(np.asarray(v[k0:k1]) ** 2) for v in vel]))
            for k0, k1 in zip(edges, edges[1:])]
-    level = [round(-math.log(max(r, 1e-12)) / math.log(FRICTION_LEVEL_STEP)) for r in rms]
-    out = []
-    for (k0, k1), lv in zip(zip(edges, edges[1:]), level):
-        if out and out[-1][2] == lv:
-            out[-1][1] = k1
+    out = []                       # [k0, k1, smallest rms, largest rms] per piece
+    for k0, k1, r in zip(edges, edges[1:], rms):
+        if out and max(out[-1][3], r) <= FRICTION_LEVEL_STEP * min(out[-1][2], r):
+            out[-1][1:] = [k1, min(out[-1][2], r), max(out[-1][3], r)]
         else:
-            out.append([k0, k1, lv])
-    return [(k0, k1) for k0, k1, _ in out]
+            out.append([k0, k1, r, r])
+    return [(k0, k1) for k0, k1, _, _ in out]
 
 
 def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float = 0.0,

@@ -319,6 +319,87 @@ def test_statistical_linearisation_of_leaf_friction():
     assert abs(eff["force"] / eff["velocity"] / c_eq - 1) < 0.01
 
 
+def _friction_model(c):
+    from vehicles.linear import linear_model
+    return linear_model("dump_truck_8x4", effects={"leaf_friction": {"force": c * 0.005, "velocity": 0.005}})
+
+
+def test_block_model_switches_state_spaces_exactly():
+    """A BlockModel (leaf-friction damper 5, 40, 15 kN s/m per spring over three stretches): the
+    operator's forward equals a plain loop over the physical state, x <- Ad_j x + Bd_j u, y = Cd_j x +
+    Dd_j u, with each stretch's own first-order-hold matrices (a reference without the modal
+    coordinates or the state hand-over), to 1e-10 of the response (rounding: measured 1e-13); its
+    adjoint is exact to 1e-10; and one model cut into three pieces is that model (1e-12)."""
+    from scipy.signal import cont2discrete
+
+    from inverse.replica import BlockModel
+
+    fs = 100.0
+    t = np.arange(int(5 * fs)) / fs
+    v = 10.0 + np.linspace(-2, 2, t.size)
+    A, B, C = (_friction_model(c) for c in (5e3, 4e4, 1.5e4))
+    names = ["susp_disp_1L", "axle_acc_2R", "body_acc_3L", "susp_disp_4R"]
+    op = ReplicaOperator(BlockModel(A, [(0, A), (150, B), (380, C)], [5e3, 4e4, 1.5e4], [0.1] * 3),
+                         t, v, names)
+    rng = np.random.default_rng(2)
+    z = np.concatenate([np.cumsum(rng.standard_normal(op.n_grid)) * 1e-3,
+                        np.cumsum(rng.standard_normal(op.n_grid)) * 1e-3])
+    y = op.forward(z)
+    u = (op.Mu @ z).reshape(2 * op.nc, op.nf)
+    starts = [0, op.i_out[150], op.i_out[380]]
+    disc = []
+    for m in (A, B, C):
+        a_, b_ = m.state_space()
+        c_, d_ = m.output_matrices(names, a_, b_)
+        disc.append(cont2discrete((a_, b_, c_, d_), 1.0 / fs, method="foh")[:4])
+    x = np.zeros(A.state_space()[0].shape[0])
+    ref = np.zeros((len(names), op.nf))
+    for i in range(op.nf):
+        Ad, Bd, Cd, Dd = disc[sum(i >= s for s in starts) - 1]
+        ref[:, i] = Cd @ x + Dd @ u[:, i]
+        x = Ad @ x + Bd @ u[:, i]
+    ref = ref[:, op.i_out]
+    assert np.max(np.abs(y - ref)) <= 1e-10 * np.max(np.abs(ref))
+    Y = rng.standard_normal(y.shape)
+    zz = rng.standard_normal(op.n_unknowns)
+    a, b = np.sum(op.forward(zz) * Y), zz @ op.adjoint(Y)
+    assert abs(a - b) <= 1e-10 * abs(a)
+    one = ReplicaOperator(A, t, v, names).forward(z)
+    cut = ReplicaOperator(BlockModel(A, [(0, A), (150, A), (380, A)], [1.0] * 3, [0.1] * 3), t, v, names)
+    assert np.max(np.abs(cut.forward(z) - one)) <= 1e-12 * np.max(np.abs(one))
+
+
+def test_leaf_friction_linearised_per_block():
+    """A drive whose suspension is quiet for 10 s (RMS 12 mm/s) and then loud (120 mm/s) gets two
+    pieces at the 10 s boundary, each with the closed-form damper of its own velocity RMS
+    (c = F sqrt(2/pi) / s, within 2 %: the low-pass and the gradient at the stretch's ends), and the
+    note says the range; per_block=False gives one damper and the stop-71 warning."""
+    import math
+
+    from inverse.replica import BlockModel, replica_linear_model
+
+    fs = 200.0
+    t = np.arange(int(30 * fs)) / fs
+    f0 = 2.0
+    amp = np.where(t < 10.0, 0.012, 0.12) * math.sqrt(2)      # velocity amplitude: RMS 12 / 120 mm/s
+    disp = {f"susp_disp_{k}{s}": np.cumsum(amp * np.cos(2 * np.pi * f0 * t)) / fs
+            for k in (1, 2, 3, 4) for s in "LR"}
+    lm, left, notes = replica_linear_model("dump_truck_8x4", {"leaf_friction": {"force": 2000.0}}, disp, fs,
+                                           t0=100.0)
+    assert isinstance(lm, BlockModel) and left == []
+    assert [k for k, _ in lm.pieces] == [0, int(10 * fs)]
+    for c, s in zip(lm.damping, (0.012, 0.12)):
+        assert abs(c / (2000.0 * math.sqrt(2 / math.pi) / s) - 1) < 0.02, (c, s)
+    for (_, m), c in zip(lm.pieces, lm.damping):
+        eff = m.meta["effects"]["leaf_friction"]
+        assert abs(eff["force"] / eff["velocity"] / c - 1) < 1e-9
+    assert "per 5 s block" in notes[0] and "2 pieces" in notes[0]
+    assert lm.contacts == lm.reference.contacts                  # the rest is the reference model's
+    one, _, notes1 = replica_linear_model("dump_truck_8x4", {"leaf_friction": {"force": 2000.0}}, disp, fs,
+                                          t0=100.0, per_block=False)
+    assert not isinstance(one, BlockModel) and notes1[1].startswith("WARNING: ") and "100-105 s" in notes1[1]
+
+
 def test_segment_psd_against_an_inversion_agrees_on_a_known_profile():
     # a replica whose tracks ARE an ISO profile of known level and waviness, driven at
     # 10 m/s, compared with "inversion segments" carrying the same parameters: the mean
