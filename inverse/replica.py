@@ -769,6 +769,20 @@ def friction_blocks(vel, fs: float) -> list:
     return [(k0, k1) for k0, k1, _, _ in out]
 
 
+def friction_block_table(lm, time) -> list:
+    """The leaf friction's equivalent damper along the record, for summary.json: one row per piece of a
+    :class:`BlockModel` (``t_start_s``, ``t_end_s`` record time, ``damping_N_s_per_m`` per spring,
+    ``suspension_velocity_rms_m_per_s``); [] for one model (the damper, if any, is in ``effects``)."""
+    if not isinstance(lm, BlockModel):
+        return []
+    time = np.asarray(time, float)
+    dt = float(np.median(np.diff(time)))
+    ks = [k for k, _ in lm.pieces] + [time.size]
+    return [{"t_start_s": float(time[a]), "t_end_s": float(time[b - 1] + dt), "damping_N_s_per_m": float(c),
+             "suspension_velocity_rms_m_per_s": float(v)}
+            for a, b, c, v in zip(ks, ks[1:], lm.damping, lm.speed_rms)]
+
+
 def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float = 0.0,
                          per_block: bool = True) -> tuple:
     """The linear model of the replica with the given effects.
@@ -1269,7 +1283,8 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout="auto", fo
             "psd_iso_fit": fits,
             "against_inversion": inv_info,
             "linear_model": {"effects": {k: dict(v) for k, v in lm.meta.get("effects", {}).items()},
-                             "effects_left_out": left_out, "notes": rep.info["linear_model_notes"] + lin_notes},
+                             "effects_left_out": left_out, "notes": rep.info["linear_model_notes"] + lin_notes,
+                             "friction_blocks": friction_block_table(lm, drive.time)},
             "figures": figs,
             "files": ["tracks.csv", "iri.csv", "psd.csv", "road.npz", "road.crg"]
                      + (["psd_segments.csv"] if inversion is not None else []),

@@ -287,6 +287,7 @@ def test_effects_auto_uses_the_diagnosis_verdict(tmp_path):
     s = json.loads((tmp_path / "r1" / "summary.json").read_text())
     assert s["closed_loop"]["corrected"] and "leaf_friction" in s["linear_model"]["effects"]
     assert any("statistically linearised" in n for n in s["linear_model"]["notes"])
+    assert s["linear_model"]["friction_blocks"] == []          # 8 s: one block, one damper (in effects)
     assert (tmp_path / "r1" / "diagnose" / "summary.json").is_file()
     none = fake_diagnosis("diag2", "none", None)
     assert main(["replica", str(ds), "--out", str(tmp_path / "r2"), "--effects", "auto", "--diagnosis", str(none),
@@ -398,6 +399,11 @@ def test_leaf_friction_linearised_per_block():
     one, _, notes1 = replica_linear_model("dump_truck_8x4", {"leaf_friction": {"force": 2000.0}}, disp, fs,
                                           t0=100.0, per_block=False)
     assert not isinstance(one, BlockModel) and notes1[1].startswith("WARNING: ") and "100-105 s" in notes1[1]
+    # what summary.json lists: each piece's record times, damper and velocity RMS
+    from inverse.replica import friction_block_table
+    rows = friction_block_table(lm, t + 100.0)
+    assert [r["t_start_s"] for r in rows] == [100.0, 110.0] and abs(rows[-1]["t_end_s"] - 130.0) < 1e-9
+    assert [r["damping_N_s_per_m"] for r in rows] == lm.damping and friction_block_table(one, t) == []
 
 
 def test_segment_psd_against_an_inversion_agrees_on_a_known_profile():
