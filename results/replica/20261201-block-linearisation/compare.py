@@ -6,7 +6,7 @@ Each `random` drive (made in CACHE as benchmarks/bench_replica.py makes it, if a
 twice with the truth's effects (leaf_friction=2000, frame_flex=1): per_block=False (stop 71: one
 statistically linearised damper, a warning where a block would need one > 3x stiffer) and
 per_block=True.  Per 5 s block: warned by the stop-71 rule or not; ln(replica PSD / truth PSD) at
-0.5-2 m (front tyre lines, mean of both sides); band-passed (0.5-20 m) correlation with the truth."""
+0.5-2 m (side tracks: the mean of each side's tyre lines, the truth's likewise; mean of both sides); band-passed (0.5-20 m) correlation with the truth."""
 import json
 import sys
 from pathlib import Path
