@@ -783,6 +783,57 @@ def friction_block_table(lm, time) -> list:
             for a, b, c, v in zip(ks, ks[1:], lm.damping, lm.speed_rms)]
 
 
+#: high-pass [Hz] of a suspension velocity integrated from accelerations: the integral's drift and the
+#: accelerometers' low-frequency error go, the suspension's own motion (body bounce 1-2 Hz, axle hop
+#: ~10 Hz) stays
+VELOCITY_HIGHPASS_HZ = 0.5
+
+
+def suspension_velocities(channels: dict, vp, axles, fs: float) -> tuple:
+    """Suspension (compression) velocities [m/s] at the spring seats of ``axles``, and where they came
+    from.
+
+    From ``susp_disp_<a><s>`` (measured at the spring seat): its derivative, low-passed at
+    :data:`VELOCITY_LOWPASS_HZ` (the displacement's noise would inflate it above).  Where a drive logs
+    no displacement on those axles (the format allows any subset of channels), from the accelerations:
+    ``axle_acc`` is measured at the axle END, so the spring seat's is rebuilt from both ends of the
+    axle, ``(a_L + a_R) / 2 +- r (a_L - a_R) / 2`` with r = spring track / wheel track (a rigid axle;
+    without it the axle's roll counts about twice), minus ``body_acc`` of that seat, integrated
+    (trapezoid), its linear trend removed and band-passed from :data:`VELOCITY_HIGHPASS_HZ` to
+    :data:`VELOCITY_LOWPASS_HZ`.  ``vp``: the vehicle (VehicleParams).  Returns ``([arrays], source)``,
+    ``source`` '' for displacements, a phrase for the note otherwise; ``([], '')`` when neither is
+    there (a station needs both axle ends and its body acceleration).
+    """
+    from scipy.signal import butter, sosfiltfilt
+
+    lo = butter(4, min(VELOCITY_LOWPASS_HZ, 0.4 * fs), fs=fs, output="sos")
+    disp = [np.asarray(y, float) for c, y in channels.items()
+            if c.startswith("susp_disp_") and axle_of(c) in axles]
+    if disp:
+        return [np.gradient(sosfiltfilt(lo, d - d.mean())) * fs for d in disp], ""
+    band = butter(4, [VELOCITY_HIGHPASS_HZ, min(VELOCITY_LOWPASS_HZ, 0.4 * fs)], btype="band", fs=fs, output="sos")
+    vel = []
+    for a in sorted(axles):
+        ends = [channels.get(f"axle_acc_{a}{s}") for s in "LR"]
+        if any(e is None for e in ends):
+            continue
+        aL, aR = (np.asarray(e, float) for e in ends)
+        r = vp.axles[a - 1].spring_track / vp.axles[a - 1].track
+        for side, sign in (("L", 1.0), ("R", -1.0)):
+            body = channels.get(f"body_acc_{a}{side}")
+            if body is None:
+                continue
+            rel = 0.5 * (aL + aR) + sign * r * 0.5 * (aL - aR) - np.asarray(body, float)
+            v = np.concatenate([[0.0], np.cumsum(0.5 * (rel[1:] + rel[:-1]))]) / fs
+            k = np.arange(v.size)
+            vel.append(sosfiltfilt(band, v - np.polyval(np.polyfit(k, v, 1), k)))
+    if not vel:
+        return [], ""
+    return vel, (f" (suspension velocity from the accelerations, axle at its spring seat minus body, "
+                 f"integrated, {VELOCITY_HIGHPASS_HZ:g}-{VELOCITY_LOWPASS_HZ:g} Hz: no susp_disp on the "
+                 f"leaf-spring axles)")
+
+
 def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float = 0.0,
                          per_block: bool = True) -> tuple:
     """The linear model of the replica with the given effects.
@@ -795,7 +846,8 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
     Linearization).  The effect's smoothed force F tanh(v / v0), linearised at rest as
     the linear model does, is a damper F / v0; so the force handed to it is c_eq v0, with s
     the RMS over the leaf-spring stations of the measured suspension velocity
-    (derivative of ``susp_disp_*``, low-passed at :data:`VELOCITY_LOWPASS_HZ`).
+    (:func:`suspension_velocities`: from ``susp_disp_*``, or from axle and body accelerations
+    where a drive logs no displacement there).
 
     ``per_block`` (default): s, and so the damper, is taken per :data:`FRICTION_BLOCK_S` block
     of the record (:func:`friction_blocks`) and the model returned is a :class:`BlockModel` that
@@ -813,8 +865,6 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
     (model, left_out, notes) : the model (a LinearModel, or a BlockModel), the effects left out,
     lines for the report.
     """
-    from scipy.signal import butter, sosfiltfilt
-
     from inverse.linear_features import split_linear_effects
     from vehicles.linear import linear_model
     from vehicles.params import load_vehicle
@@ -825,11 +875,8 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
     left = sorted(set(nonlinear) - {"leaf_friction"} - set(keep))     # friction, where linearised below
     if "leaf_friction" in nonlinear and nonlinear["leaf_friction"]["force"] > 0:
         leaf_axles = {i + 1 for i, a in enumerate(vp.axles) if getattr(a, "spring_type", "") == "leaf"}
-        disp = [np.asarray(y, float) for c, y in channels.items()
-                if c.startswith("susp_disp_") and axle_of(c) in leaf_axles]
-        if disp:
-            sos = butter(4, min(VELOCITY_LOWPASS_HZ, 0.4 * fs), fs=fs, output="sos")
-            vel = [np.gradient(sosfiltfilt(sos, d - d.mean())) * fs for d in disp]
+        vel, source = suspension_velocities(channels, vp, leaf_axles, fs)
+        if vel:
             p = dict(nonlinear["leaf_friction"])
 
             def model_at(s):
@@ -845,13 +892,13 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
                 made = [model_at(r) for r in rms]
                 cs = [c for _, c in made]
                 notes.append(f"leaf_friction {p['force']:.0f} N statistically linearised per "
-                             f"{FRICTION_BLOCK_S:.0f} s block: suspension velocity RMS {1e3 * min(rms):.0f}-"
+                             f"{FRICTION_BLOCK_S:.0f} s block{source}: suspension velocity RMS {1e3 * min(rms):.0f}-"
                              f"{1e3 * max(rms):.0f} mm/s -> damping {min(cs):.0f}-{max(cs):.0f} N s/m per "
                              f"spring in {len(blocks)} pieces (one damper for the drive: {c_ref:.0f})")
                 return (BlockModel(ref, [(k0, m) for (k0, _), (m, _) in zip(blocks, made)], cs, rms),
                         left, notes)
-            notes.append(f"leaf_friction {p['force']:.0f} N statistically linearised: suspension velocity "
-                         f"RMS {s * 1e3:.0f} mm/s -> damping {c_ref:.0f} N s/m per spring")
+            notes.append(f"leaf_friction {p['force']:.0f} N statistically linearised{source}: suspension "
+                         f"velocity RMS {s * 1e3:.0f} mm/s -> damping {c_ref:.0f} N s/m per spring")
             if not per_block:
                 spread = friction_block_spread(vel, fs, s, t0)
                 if spread is not None:
