@@ -1001,7 +1001,9 @@ def inversion_segment_psd(seg: dict, n) -> np.ndarray:
 
 def segment_psd_rows(rep: Replica, time, segments: list, band_m=(0.5, 20.0)) -> list:
     """Per inversion segment: the replica's PSD over the stretch axle 1 drove during the
-    segment (both tracks' periodograms averaged, Welch segments of at most 1/4 of it)
+    segment (every tyre line's periodogram averaged -- the inversion's PSD is one line's, and a
+    side track, the mean of that side's lines, has less power at short waves where they differ;
+    the side tracks where the replica has no lines; Welch segments of at most 1/4 of it)
     against the inversion's fitted PSD there.
 
     Returns a list of dicts: segment, t_start, t_end [s], x_start, x_end [m], the
@@ -1022,7 +1024,8 @@ def segment_psd_rows(rep: Replica, time, segments: list, band_m=(0.5, 20.0)) -> 
         m = (rep.x >= x0) & (rep.x <= x1)
         if m.sum() < 64:
             continue
-        est = profile_psd(np.stack([rep.z_left[m], rep.z_right[m]], axis=1), dx,
+        profiles = [zl for _, _, zl in (getattr(rep, "lines", None) or [])] or [rep.z_left, rep.z_right]
+        est = profile_psd(np.stack([z[m] for z in profiles], axis=1), dx,
                           nperseg=int(2 ** math.floor(math.log2(max(32, m.sum() // 4)))))
         n, G = est.n[1:], est.G[1:]
         fit = inversion_segment_psd(seg, n)
@@ -1048,7 +1051,7 @@ def plot_segment_psd(rows: list, path, title: str = "") -> None:
     nr = int(math.ceil(k / cols))
     fig, axes = plt.subplots(nr, cols, figsize=(4.2 * cols, 3.4 * nr + 0.6), squeeze=False)
     for ax, r in zip(axes.ravel(), rows):
-        ax.loglog(r["n"], r["G"], "C0", lw=1.0, label="replica (both tracks)")
+        ax.loglog(r["n"], r["G"], "C0", lw=1.0, label="replica (every tyre line)")
         ax.loglog(r["n"], r["fit"], "k--", lw=1.2,
                   label=f"inversion fit ({r['road_model'].replace('_', ' ')}, class {r['class']})")
         ax.axvspan(*r["band"], color="0.92", zorder=0)

@@ -438,6 +438,30 @@ def test_segment_psd_against_an_inversion_agrees_on_a_known_profile():
     assert np.allclose(inversion_segment_psd(two, n), two_slope_psd(n, 1e-4, 2.5, 1.5, 0.3))
 
 
+def test_segment_psd_reads_the_tyre_lines_not_their_mean():
+    """The inversion's PSD is one line's; a side track is the mean of its side's tyre lines, whose
+    short waves partly cancel.  Closed form: two independent profiles of one PSD per side (lines at
+    different lateral positions, uncorrelated) have a mean with half their PSD, ln -0.69; the rows must
+    read the lines (ln ratio within 0.3, the same tolerance as the known-profile test above) and not
+    the mean (which would be near -0.69)."""
+    from types import SimpleNamespace
+
+    from inverse.replica import segment_psd_rows
+    from roadlib.synthesis import SpectralParams, synth_profile
+
+    p = SpectralParams(Gq_n0=64e-6, w=2.0, nmin=0.02, nmax=5.0, dx=0.1)
+    x, a = synth_profile(p, 400.0, seed=3)
+    b, c, d = (synth_profile(p, 400.0, seed=k)[1] for k in (4, 5, 6))
+    lines = [("L", 0.8, a), ("L", 1.1, b), ("R", 0.8, c), ("R", 1.1, d)]
+    t = np.arange(0, 40.0, 0.01)
+    rep = SimpleNamespace(x=x, z_left=(a + b) / 2, z_right=(c + d) / 2, lines=lines,
+                          operator=SimpleNamespace(s_record=10.0 * t))
+    seg = [{"t_start": 0.0, "t_end": 39.0, "Gq_n0": 64e-6, "w": 2.0, "nmin": 0.05, "nmax": 2.0, "class": "C"}]
+    assert abs(segment_psd_rows(rep, t, seg)[0]["ln_ratio"]) < 0.3
+    rep.lines = []                                              # no lines: the side tracks, and their mean shows
+    assert segment_psd_rows(rep, t, seg)[0]["ln_ratio"] < -0.45
+
+
 def test_one_friction_damper_too_soft_for_a_quiet_stretch_is_said():
     """The replica's statistically linearised leaf friction has one damper for the whole drive; a
     5 s block whose suspension moves at a third or less of the drive's RMS (its damper would be 3x
