@@ -711,34 +711,48 @@ VELOCITY_LOWPASS_HZ = 25.0
 
 
 class BlockModel:
-    """A linear model whose leaf-friction damper changes along the drive.
+    """A linear model whose statistically linearised nonlinear effects change along the drive.
 
     ``pieces``: ``[(k0, LinearModel), ...]``, the record sample at which each model takes over
     (the first at 0; the first also serves the run-in); ``reference``: the model for what needs one
     linear model (identified band, EM's posterior variance, CG's preconditioner, contacts, outputs),
-    which every other attribute is read from; ``damping``: the equivalent damper of each piece
-    [N s/m per spring]; ``speed_rms``: its suspension velocity RMS [m/s].
+    which every other attribute is read from; ``values``: per linearised effect, its equivalent
+    coefficient in each piece (``leaf_friction``: damper [N s/m per spring]; ``bump_stop``: stiffness
+    [N/m per suspension]); ``measured``: what it came from (velocity RMS [m/s], displacement RMS [m]).
     :class:`ReplicaOperator` switches between the pieces' state spaces, carrying the state.
     """
 
-    def __init__(self, reference, pieces, damping, speed_rms):
+    def __init__(self, reference, pieces, values, measured):
         self.reference = reference
         self.pieces = list(pieces)
-        self.damping = list(damping)
-        self.speed_rms = list(speed_rms)
+        self.values = {k: list(v) for k, v in values.items()}
+        self.measured = {k: list(v) for k, v in measured.items()}
+
+    @property
+    def damping(self) -> list:
+        """The leaf friction's equivalent damper per piece [N s/m per spring] ([] without it)."""
+        return self.values.get("leaf_friction", [])
+
+    @property
+    def speed_rms(self) -> list:
+        """The suspension velocity RMS per piece the friction was linearised on [m/s]."""
+        return self.measured.get("leaf_friction", [])
 
     def __getattr__(self, name):
-        if name in ("reference", "pieces", "damping", "speed_rms"):   # not set yet (copy, unpickle)
+        if name in ("reference", "pieces", "values", "measured"):   # not set yet (copy, unpickle)
             raise AttributeError(name)
         return getattr(self.reference, name)
 
 
-#: blocks [s] over which the leaf friction is linearised (:func:`replica_linear_model`)
+#: blocks [s] over which nonlinear effects are linearised (:func:`replica_linear_model`)
 FRICTION_BLOCK_S = 5.0
-#: neighbouring blocks whose equivalent dampers lie within this factor of each other share one
-#: linear model, linearised on their joint velocity RMS (a damper within ~+-9 % of a block's own
-#: changes the replica far less than the noise does; fewer pieces, fewer model switches)
+#: neighbouring blocks whose equivalent coefficients all lie within this factor of each other share
+#: one linear model, linearised on their joint samples (a damper or stiffness within ~+-9 % of a
+#: block's own changes the replica far less than the noise does; fewer pieces, fewer model switches)
 FRICTION_LEVEL_STEP = 2.0 ** 0.25
+#: equivalent bump-stop stiffnesses below this count as none when blocks are joined, and are not
+#: handed to the model [N/m] (0.1-0.3 % of the truck's suspension springs)
+BUMP_STOP_FLOOR = 5.0e3
 
 
 def statistical_damper(force: float, velocity: float, s: float) -> float:
@@ -748,39 +762,72 @@ def statistical_damper(force: float, velocity: float, s: float) -> float:
     return force / max(velocity, s * math.sqrt(math.pi / 2.0))
 
 
-def friction_blocks(vel, fs: float) -> list:
-    """Sample ranges ``(k0, k1)`` of :data:`FRICTION_BLOCK_S` blocks, neighbours joined while their
-    velocity RMS (so their dampers) stay within :data:`FRICTION_LEVEL_STEP` of each other, from the
-    leaf-spring stations' suspension velocities ``vel`` [m/s]; the last part-block joins the last
-    block."""
-    m = min(len(v) for v in vel)
+def bump_stop_force(u, gap: float, stiffness: float, smoothing: float) -> np.ndarray:
+    """The bump stop's force [N] at compression ``u`` [m] from static equilibrium: the effect's own law
+    (vehicles/effects/bump_stop.py), ``k s softplus((u - gap) / s)``, zero at u = 0."""
+    x = (np.asarray(u, float) - gap) / smoothing
+    f0 = stiffness * smoothing * math.log1p(math.exp(-gap / smoothing))
+    return stiffness * smoothing * (np.maximum(x, 0.0) + np.log1p(np.exp(-np.abs(x)))) - f0
+
+
+@dataclass
+class Equivalent:
+    """One nonlinear effect's statistical linearisation over stretches of the record.
+
+    ``value(k0, k1)``: ``(coefficient, measured RMS)`` over samples [k0, k1); ``params(c)``: the
+    effect's parameters whose slope at rest is ``c`` (what :func:`vehicles.linear.linear_model`
+    linearises), or None where nothing is to be added; ``floor``: coefficients below it count as one
+    level when blocks are joined."""
+
+    effect: str
+    value: object
+    params: object
+    floor: float = 0.0
+
+
+def linearisation_blocks(equivalents, m: int, fs: float) -> list:
+    """Sample ranges ``(k0, k1)`` of :data:`FRICTION_BLOCK_S` blocks of an ``m``-sample record,
+    neighbours joined while every equivalent coefficient stays within :data:`FRICTION_LEVEL_STEP` of
+    its others in the piece (coefficients below their ``floor`` count as the floor); the last
+    part-block joins the last block."""
     n = int(round(FRICTION_BLOCK_S * fs))
     if n < 2 or m < 2 * n:
         return [(0, m)]
     edges = [i * n for i in range(m // n)] + [m]
-    rms = [math.sqrt(np.mean([np.mean(np.asarray(v[k0:k1]) ** 2) for v in vel]))
-           for k0, k1 in zip(edges, edges[1:])]
-    out = []                       # [k0, k1, smallest rms, largest rms] per piece
-    for k0, k1, r in zip(edges, edges[1:], rms):
-        if out and max(out[-1][3], r) <= FRICTION_LEVEL_STEP * min(out[-1][2], r):
-            out[-1][1:] = [k1, min(out[-1][2], r), max(out[-1][3], r)]
-        else:
-            out.append([k0, k1, r, r])
+    out = []                     # [k0, k1, lows, highs] per piece
+    for k0, k1 in zip(edges, edges[1:]):
+        v = [max(e.value(k0, k1)[0], e.floor, 1e-300) for e in equivalents]
+        if out:
+            lo = [min(a, b) for a, b in zip(out[-1][2], v)]
+            hi = [max(a, b) for a, b in zip(out[-1][3], v)]
+            if all(h <= FRICTION_LEVEL_STEP * lw for lw, h in zip(lo, hi)):
+                out[-1][1:] = [k1, lo, hi]
+                continue
+        out.append([k0, k1, v, v])
     return [(k0, k1) for k0, k1, _, _ in out]
 
 
-def friction_block_table(lm, time) -> list:
-    """The leaf friction's equivalent damper along the record, for summary.json: one row per piece of a
-    :class:`BlockModel` (``t_start_s``, ``t_end_s`` record time, ``damping_N_s_per_m`` per spring,
-    ``suspension_velocity_rms_m_per_s``); [] for one model (the damper, if any, is in ``effects``)."""
+def block_table(lm, time) -> list:
+    """The linearised effects' coefficients along the record, for summary.json: one row per piece of
+    a :class:`BlockModel` (``t_start_s``, ``t_end_s`` record time; ``damping_N_s_per_m`` per spring and
+    ``suspension_velocity_rms_m_per_s`` for the friction; ``bump_stop_stiffness_N_per_m`` per
+    suspension and ``suspension_displacement_rms_m`` for bump stops); [] for one model (its
+    coefficients are in ``effects``)."""
     if not isinstance(lm, BlockModel):
         return []
     time = np.asarray(time, float)
     dt = float(np.median(np.diff(time)))
     ks = [k for k, _ in lm.pieces] + [time.size]
-    return [{"t_start_s": float(time[a]), "t_end_s": float(time[b - 1] + dt), "damping_N_s_per_m": float(c),
-             "suspension_velocity_rms_m_per_s": float(v)}
-            for a, b, c, v in zip(ks, ks[1:], lm.damping, lm.speed_rms)]
+    cols = {"leaf_friction": ("damping_N_s_per_m", "suspension_velocity_rms_m_per_s"),
+            "bump_stop": ("bump_stop_stiffness_N_per_m", "suspension_displacement_rms_m")}
+    rows = []
+    for i, (a, b) in enumerate(zip(ks, ks[1:])):
+        row = {"t_start_s": float(time[a]), "t_end_s": float(time[b - 1] + dt)}
+        for eff, (cv, cm) in cols.items():
+            if eff in lm.values:
+                row[cv], row[cm] = float(lm.values[eff][i]), float(lm.measured[eff][i])
+        rows.append(row)
+    return rows
 
 
 #: high-pass [Hz] of a suspension velocity integrated from accelerations: the integral's drift and the
@@ -838,27 +885,33 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
                          per_block: bool = True) -> tuple:
     """The linear model of the replica with the given effects.
 
-    Linear effects enter as they are.  ``leaf_friction`` (nonlinear) enters by
-    STATISTICAL LINEARISATION (DECISION, docs/replica.md): for a Gaussian compression
-    velocity v of standard deviation s, the viscous damping that best replaces the
-    Coulomb force F sign(v) in the mean-square sense is c_eq = E[F sign(v) v] / E[v^2]
-    = F sqrt(2 / pi) / s (Roberts & Spanos, Random Vibration and Statistical
-    Linearization).  The effect's smoothed force F tanh(v / v0), linearised at rest as
-    the linear model does, is a damper F / v0; so the force handed to it is c_eq v0, with s
-    the RMS over the leaf-spring stations of the measured suspension velocity
-    (:func:`suspension_velocities`: from ``susp_disp_*``, or from axle and body accelerations
-    where a drive logs no displacement there).
+    Linear effects enter as they are.  Nonlinear ones enter by STATISTICAL LINEARISATION
+    (DECISION, docs/replica.md), each as the linear coefficient that best replaces its force in the
+    mean-square sense over the measured motion, handed to the linear model as the effect's parameters
+    whose slope at rest is that coefficient:
 
-    ``per_block`` (default): s, and so the damper, is taken per :data:`FRICTION_BLOCK_S` block
-    of the record (:func:`friction_blocks`) and the model returned is a :class:`BlockModel` that
-    switches between them: friction that nearly locks the springs on a smooth stretch and slips
-    on a rough one is not one damper (one damper for the whole drive made the embedded drive's
-    class A segment 5-8x too smooth at 0.5-2 m, results/replica/20261201-smooth-segment/;
-    per block: results/replica/20261201-block-linearisation/).  ``per_block=False``: one damper
-    for the whole drive, with a warning where a block would need one more than
-    ``FRICTION_BLOCK_RATIO`` times stiffer (:func:`friction_block_spread`; ``t0``: the record
-    time of the first sample, for the notes' times).  Other nonlinear effects (bump stops,
-    damper asymmetry) are left out, as in the linear fit.
+    * ``leaf_friction``: for a Gaussian compression velocity v of standard deviation s the Coulomb
+      force F sign(v) is best replaced by c_eq = E[F sign(v) v] / E[v^2] = F sqrt(2 / pi) / s (Roberts
+      & Spanos, Random Vibration and Statistical Linearization); s is the RMS over the leaf-spring
+      stations of the measured suspension velocity (:func:`suspension_velocities`: from ``susp_disp_*``,
+      or from axle and body accelerations where a drive logs no displacement there); the smoothed
+      force F tanh(v / v0) has slope F / v0 at rest, so the force handed over is c_eq v0;
+    * ``bump_stop``: an equivalent stiffness k_eq = sum mean(F(u) u) / sum mean(u^2) over the stations,
+      F the effect's own force law (:func:`bump_stop_force`) and u the measured ``susp_disp`` about its
+      mean -- the measured amplitude distribution, no Gaussian assumption; handed over as a bump stop
+      of gap 0, whose slope at rest is half its stiffness.  Needs ``susp_disp`` (else left out).
+    * ``damper_asymmetry`` keeps the mean damping, so its linearisation for a symmetric velocity is
+      the nominal damper: left out, exactly.
+
+    ``per_block`` (default): the coefficients are taken per :data:`FRICTION_BLOCK_S` block of the
+    record (:func:`linearisation_blocks`) and the model returned is a :class:`BlockModel` that
+    switches between them: friction that nearly locks the springs on a smooth stretch and slips on a
+    rough one is not one damper (one damper for the whole drive made the embedded drive's class A
+    segment 5-8x too smooth at 0.5-2 m, results/replica/20261201-smooth-segment/; per block:
+    results/replica/20261201-block-linearisation/), and a bump stop engages only where the road is
+    rough.  ``per_block=False``: one model for the whole drive, with a warning where a block would
+    need a friction damper more than ``FRICTION_BLOCK_RATIO`` times stiffer
+    (:func:`friction_block_spread`; ``t0``: the record time of the first sample, for the notes' times).
 
     Returns
     -------
@@ -871,41 +924,79 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
 
     vp = load_vehicle(vehicle)
     keep, nonlinear = split_linear_effects(effects)
-    notes = []
-    left = sorted(set(nonlinear) - {"leaf_friction"} - set(keep))     # friction, where linearised below
+    notes, eqs, vel, source = [], [], None, ""
+    m = min((len(np.asarray(y)) for y in channels.values()), default=0)
     if "leaf_friction" in nonlinear and nonlinear["leaf_friction"]["force"] > 0:
         leaf_axles = {i + 1 for i, a in enumerate(vp.axles) if getattr(a, "spring_type", "") == "leaf"}
         vel, source = suspension_velocities(channels, vp, leaf_axles, fs)
         if vel:
-            p = dict(nonlinear["leaf_friction"])
+            pf = dict(nonlinear["leaf_friction"])
 
-            def model_at(s):
-                c = statistical_damper(p["force"], p["velocity"], s)
-                eff = dict(keep, leaf_friction={"force": c * p["velocity"], "velocity": p["velocity"]})
-                return linear_model(vp, "rigid", effects=eff), c     # F'/v0 = c_eq
+            def friction_value(k0, k1, vel=vel, pf=pf):
+                s = math.sqrt(np.mean([np.mean(np.asarray(v[k0:k1]) ** 2) for v in vel]))
+                return statistical_damper(pf["force"], pf["velocity"], s), s
+            eqs.append(Equivalent("leaf_friction", friction_value,
+                                  lambda c, pf=pf: {"force": c * pf["velocity"], "velocity": pf["velocity"]}))
+    if "bump_stop" in nonlinear:
+        U = np.array([np.asarray(y, float) - np.mean(y) for c, y in channels.items() if c.startswith("susp_disp_")])
+        if U.size:
+            pb = dict(nonlinear["bump_stop"])
 
-            s = float(np.sqrt(np.mean([np.mean(v ** 2) for v in vel])))
-            ref, c_ref = model_at(s)
-            blocks = friction_blocks(vel, fs) if per_block else [(0, len(vel[0]))]
-            if len(blocks) > 1:
-                rms = [float(np.sqrt(np.mean([np.mean(v[k0:k1] ** 2) for v in vel]))) for k0, k1 in blocks]
-                made = [model_at(r) for r in rms]
-                cs = [c for _, c in made]
-                notes.append(f"leaf_friction {p['force']:.0f} N statistically linearised per "
-                             f"{FRICTION_BLOCK_S:.0f} s block{source}: suspension velocity RMS {1e3 * min(rms):.0f}-"
-                             f"{1e3 * max(rms):.0f} mm/s -> damping {min(cs):.0f}-{max(cs):.0f} N s/m per "
-                             f"spring in {len(blocks)} pieces (one damper for the drive: {c_ref:.0f})")
-                return (BlockModel(ref, [(k0, m) for (k0, _), (m, _) in zip(blocks, made)], cs, rms),
-                        left, notes)
-            notes.append(f"leaf_friction {p['force']:.0f} N statistically linearised{source}: suspension "
-                         f"velocity RMS {s * 1e3:.0f} mm/s -> damping {c_ref:.0f} N s/m per spring")
-            if not per_block:
-                spread = friction_block_spread(vel, fs, s, t0)
-                if spread is not None:
-                    notes.append(spread)
-            return ref, left, notes
-    left = sorted(set(nonlinear) - set(keep))
-    return linear_model(vp, "rigid", effects=keep or None), left, notes   # applied in the effects' own order
+            def stop_value(k0, k1, U=U, pb=pb):
+                u = U[:, k0:k1]
+                f = bump_stop_force(u, pb["gap"], pb["stiffness"], pb["smoothing"])
+                return float(np.sum(np.mean(f * u, axis=1)) / np.sum(np.mean(u * u, axis=1))), \
+                    float(np.sqrt(np.mean(u * u)))
+            eqs.append(Equivalent("bump_stop", stop_value,
+                                  lambda k, pb=pb: ({"gap": 0.0, "stiffness": 2.0 * k, "smoothing": pb["smoothing"]}
+                                                    if k >= BUMP_STOP_FLOOR else None), BUMP_STOP_FLOOR))
+    left = sorted(set(nonlinear) - set(keep) - {e.effect for e in eqs})
+    if not eqs:
+        return linear_model(vp, "rigid", effects=keep or None), left, notes   # applied in the effects' own order
+
+    def model_over(k0, k1):
+        vals = {e.effect: e.value(k0, k1) for e in eqs}
+        eff = dict(keep)
+        for e in eqs:
+            par = e.params(vals[e.effect][0])
+            if par is not None:
+                eff[e.effect] = par
+        return linear_model(vp, "rigid", effects=eff), vals
+
+    ref, ref_vals = model_over(0, m)
+    blocks = linearisation_blocks(eqs, m, fs) if per_block else [(0, m)]
+    if len(blocks) > 1:
+        made = [model_over(k0, k1) for k0, k1 in blocks]
+        values = {e.effect: [v[e.effect][0] for _, v in made] for e in eqs}
+        measured = {e.effect: [v[e.effect][1] for _, v in made] for e in eqs}
+        for e in eqs:
+            notes.append(_linearised_note(e.effect, nonlinear[e.effect], values[e.effect], measured[e.effect],
+                                          ref_vals[e.effect][0], len(blocks), source))
+        return BlockModel(ref, [(k0, mod) for (k0, _), (mod, _) in zip(blocks, made)], values, measured), left, notes
+    for e in eqs:
+        notes.append(_linearised_note(e.effect, nonlinear[e.effect], [ref_vals[e.effect][0]],
+                                      [ref_vals[e.effect][1]], None, 1, source))
+    if not per_block and vel:
+        spread = friction_block_spread(vel, fs, ref_vals["leaf_friction"][1], t0)
+        if spread is not None:
+            notes.append(spread)
+    return ref, left, notes
+
+
+def _linearised_note(effect: str, p: dict, values: list, measured: list, drive_value, pieces: int,
+                     source: str) -> str:
+    """The report line of one statistically linearised effect (one model, or ``pieces`` blocks)."""
+    def span(v, scale=1.0, fmt="{:.0f}"):
+        lo, hi = fmt.format(min(v) * scale), fmt.format(max(v) * scale)
+        return lo if lo == hi else f"{lo}-{hi}"
+    where = f" per {FRICTION_BLOCK_S:.0f} s block" if pieces > 1 else ""
+    tail = f" in {pieces} pieces (one for the drive: {drive_value:.0f})" if pieces > 1 else ""
+    if effect == "leaf_friction":
+        return (f"leaf_friction {p['force']:.0f} N statistically linearised{where}{source}: suspension velocity "
+                f"RMS {span(measured, 1e3)} mm/s -> damping {span(values)} N s/m per spring{tail}")
+    return (f"bump_stop (gap {p['gap'] * 1e3:.0f} mm) statistically linearised{where} over the measured "
+            f"suspension displacement (RMS {span(measured, 1e3, '{:.1f}')} mm): equivalent stiffness "
+            f"{span(values)} N/m per suspension{tail}")
 
 
 #: the prefix of a linear-model note that is a warning (:func:`note_warnings` finds them)
@@ -1334,7 +1425,7 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout="auto", fo
             "against_inversion": inv_info,
             "linear_model": {"effects": {k: dict(v) for k, v in lm.meta.get("effects", {}).items()},
                              "effects_left_out": left_out, "notes": rep.info["linear_model_notes"] + lin_notes,
-                             "friction_blocks": friction_block_table(lm, drive.time)},
+                             "blocks": block_table(lm, drive.time)},
             "figures": figs,
             "files": ["tracks.csv", "iri.csv", "psd.csv", "road.npz", "road.crg"]
                      + (["psd_segments.csv"] if inversion is not None else []),

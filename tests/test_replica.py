@@ -287,7 +287,7 @@ def test_effects_auto_uses_the_diagnosis_verdict(tmp_path):
     s = json.loads((tmp_path / "r1" / "summary.json").read_text())
     assert s["closed_loop"]["corrected"] and "leaf_friction" in s["linear_model"]["effects"]
     assert any("statistically linearised" in n for n in s["linear_model"]["notes"])
-    assert s["linear_model"]["friction_blocks"] == []          # 8 s: one block, one damper (in effects)
+    assert s["linear_model"]["blocks"] == []          # 8 s: one block, one damper (in effects)
     assert (tmp_path / "r1" / "diagnose" / "summary.json").is_file()
     none = fake_diagnosis("diag2", "none", None)
     assert main(["replica", str(ds), "--out", str(tmp_path / "r2"), "--effects", "auto", "--diagnosis", str(none),
@@ -340,7 +340,8 @@ def test_block_model_switches_state_spaces_exactly():
     v = 10.0 + np.linspace(-2, 2, t.size)
     A, B, C = (_friction_model(c) for c in (5e3, 4e4, 1.5e4))
     names = ["susp_disp_1L", "axle_acc_2R", "body_acc_3L", "susp_disp_4R"]
-    op = ReplicaOperator(BlockModel(A, [(0, A), (150, B), (380, C)], [5e3, 4e4, 1.5e4], [0.1] * 3),
+    op = ReplicaOperator(BlockModel(A, [(0, A), (150, B), (380, C)], {"leaf_friction": [5e3, 4e4, 1.5e4]},
+                                    {"leaf_friction": [0.1] * 3}),
                          t, v, names)
     rng = np.random.default_rng(2)
     z = np.concatenate([np.cumsum(rng.standard_normal(op.n_grid)) * 1e-3,
@@ -366,7 +367,7 @@ def test_block_model_switches_state_spaces_exactly():
     a, b = np.sum(op.forward(zz) * Y), zz @ op.adjoint(Y)
     assert abs(a - b) <= 1e-10 * abs(a)
     one = ReplicaOperator(A, t, v, names).forward(z)
-    cut = ReplicaOperator(BlockModel(A, [(0, A), (150, A), (380, A)], [1.0] * 3, [0.1] * 3), t, v, names)
+    cut = ReplicaOperator(BlockModel(A, [(0, A), (150, A), (380, A)], {}, {}), t, v, names)
     assert np.max(np.abs(cut.forward(z) - one)) <= 1e-12 * np.max(np.abs(one))
 
 
@@ -400,10 +401,10 @@ def test_leaf_friction_linearised_per_block():
                                           t0=100.0, per_block=False)
     assert not isinstance(one, BlockModel) and notes1[1].startswith("WARNING: ") and "100-105 s" in notes1[1]
     # what summary.json lists: each piece's record times, damper and velocity RMS
-    from inverse.replica import friction_block_table
-    rows = friction_block_table(lm, t + 100.0)
+    from inverse.replica import block_table
+    rows = block_table(lm, t + 100.0)
     assert [r["t_start_s"] for r in rows] == [100.0, 110.0] and abs(rows[-1]["t_end_s"] - 130.0) < 1e-9
-    assert [r["damping_N_s_per_m"] for r in rows] == lm.damping and friction_block_table(one, t) == []
+    assert [r["damping_N_s_per_m"] for r in rows] == lm.damping and block_table(one, t) == []
 
 
 def test_segment_psd_against_an_inversion_agrees_on_a_known_profile():
@@ -522,3 +523,46 @@ def test_suspension_velocity_from_accelerations_matches_the_displacement(tmp_pat
         assert rms(vn[0]) / rms(vd[0]) > 1.2, (a, rms(vn[0]) / rms(vd[0]))
     lm, left, notes = replica_linear_model(d.vehicle, {"leaf_friction": {"force": 2000.0}}, acc, fs)
     assert left == [] and "from the accelerations" in notes[0]
+
+
+def test_bump_stop_linearised_on_the_measured_displacement():
+    """Bump stops enter the replica's linear model as the stiffness that best replaces their force over
+    the measured displacement.  Closed form: for a Gaussian displacement of sd sigma and a sharp stop at
+    gap g, k_eq = E[F u] / E[u^2] = k (1 - Phi(g / sigma)); with g = sigma, 0.1587 k (within 3 %: 200 000
+    samples and the 0.2 mm smoothing on a 10 mm gap).  A drive quiet for 10 s (sd 2 mm, k_eq ~ 0) then rough
+    (sd 10 mm) gets two pieces: none in the first, k_eq in the second, which the piece's linear model carries
+    as that suspension stiffness (its K differs from the nominal one by k_eq / 1e5 times what 1e5 N/m
+    adds)."""
+    import math
+
+    from scipy.stats import norm
+
+    from inverse.replica import BlockModel, block_table, bump_stop_force, replica_linear_model
+    from vehicles.linear import linear_model
+    from vehicles.params import load_vehicle
+
+    rng = np.random.default_rng(4)
+    g, k, sm = 0.01, 2.0e6, 2e-4
+    u = 0.01 * rng.standard_normal(200_000)
+    f = bump_stop_force(u, g, k, sm)
+    assert abs(float(bump_stop_force(0.0, g, k, sm))) < 1e-9 and abs(float(bump_stop_force(0.03, g, k, sm)) / (k * 0.02) - 1) < 1e-3
+    keq = float(np.mean(f * u) / np.mean(u * u))
+    assert abs(keq / (k * (1 - norm.cdf(1.0))) - 1) < 0.03, keq / k
+    fs = 200.0
+    n = int(30 * fs)
+    sd = np.where(np.arange(n) < 10 * fs, 0.002, 0.01)
+    disp = {f"susp_disp_{a}{s}": sd * rng.standard_normal(n) for a in (1, 2, 3, 4) for s in "LR"}
+    lm, left, notes = replica_linear_model("dump_truck_8x4", {"bump_stop": {"gap": g, "stiffness": k, "smoothing": sm}},
+                                           disp, fs)
+    assert isinstance(lm, BlockModel) and left == [] and [kk for kk, _ in lm.pieces] == [0, int(10 * fs)]
+    quiet, rough = lm.values["bump_stop"]
+    assert quiet < 1.0 and abs(rough / (k * (1 - norm.cdf(1.0))) - 1) < 0.05, (quiet, rough)
+    assert "bump_stop (gap 10 mm) statistically linearised per 5 s block" in notes[0]
+    vp = load_vehicle("dump_truck_8x4")
+    nom = linear_model(vp, "rigid")
+    unit = linear_model(vp, "rigid", effects={"bump_stop": {"gap": 0.0, "stiffness": 2e5, "smoothing": sm}})
+    scale = np.abs(unit.K - nom.K).max() / 1e5
+    assert np.abs(lm.pieces[0][1].K - nom.K).max() == 0.0                      # below the floor: nothing added
+    assert abs(np.abs(lm.pieces[1][1].K - nom.K).max() / scale / rough - 1) < 1e-6
+    assert "bump_stop_stiffness_N_per_m" in block_table(lm, np.arange(n) / fs)[1]
+    assert math.isclose(block_table(lm, np.arange(n) / fs)[1]["suspension_displacement_rms_m"], 0.01, rel_tol=0.05)
