@@ -947,8 +947,11 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
                 f = bump_stop_force(u, pb["gap"], pb["stiffness"], pb["smoothing"])
                 return float(np.sum(np.mean(f * u, axis=1)) / np.sum(np.mean(u * u, axis=1))), \
                     float(np.sqrt(np.mean(u * u)))
-            eqs.append(Equivalent("bump_stop", stop_value,
-                                  lambda k, pb=pb: ({"gap": 0.0, "stiffness": 2.0 * k, "smoothing": pb["smoothing"]}
+            from vehicles.effects import get_effect
+            k_top = next(q.range[1] for q in get_effect("bump_stop").parameters if q.name == "stiffness")
+            eqs.append(Equivalent("bump_stop", stop_value,     # slope at rest k/2 (its range's top at most)
+                                  lambda k, pb=pb: ({"gap": 0.0, "stiffness": min(2.0 * k, k_top),
+                                                     "smoothing": pb["smoothing"]}
                                                     if k >= BUMP_STOP_FLOOR else None), BUMP_STOP_FLOOR))
     left = sorted(set(nonlinear) - set(keep) - {e.effect for e in eqs})
     if not eqs:
