@@ -23,10 +23,12 @@ def register(subparsers) -> None:
                     "held out, and the road as .npz / .crg.")
     p.add_argument("dataset", help="dataset folder (drives format)")
     p.add_argument("--out", required=True, help="run folder to create")
-    p.add_argument("--effects", nargs="*", default=[], metavar="NAME=VALUE|auto",
-                   help="effects of the vehicle model: linear ones enter the linear model, leaf_friction by "
-                        "statistical linearisation (equivalent damping from the measured suspension velocity), "
-                        "other nonlinear ones are left out and listed; 'auto': run the diagnosis first and use "
+    p.add_argument("--effects", nargs="*", action="extend", default=[], metavar="NAME=VALUE|auto",
+                   help="effects of the vehicle model (several after one flag, or the flag repeated): linear "
+                        "ones enter the linear model; leaf_friction and bump_stop by statistical linearisation "
+                        "per 5 s block (equivalent damping from the measured suspension velocity, equivalent "
+                        "stiffness from the measured displacement); damper_asymmetry is left out (its "
+                        "linearisation is the nominal damper) and listed; 'auto': run the diagnosis first and use "
                         "the effect it names (any confidence, its value inside the search range), or, on an "
                         "unexplained gap, its closest effect where that acts on the vehicle and explains >= 60 %% "
                         "of the gap (RUN/diagnose/)")

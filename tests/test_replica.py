@@ -566,3 +566,14 @@ def test_bump_stop_linearised_on_the_measured_displacement():
     assert abs(np.abs(lm.pieces[1][1].K - nom.K).max() / scale / rough - 1) < 1e-6
     assert "bump_stop_stiffness_N_per_m" in block_table(lm, np.arange(n) / fs)[1]
     assert math.isclose(block_table(lm, np.arange(n) / fs)[1]["suspension_displacement_rms_m"], 0.01, rel_tol=0.05)
+
+
+def test_effects_flag_repeated_accumulates():
+    """`eroad replica D --effects leaf_friction=2000 --effects bump_stop.gap=0.012` keeps both (argparse's
+    plain nargs would keep only the last, silently)."""
+    from eroad.cli import build_parser
+
+    a = build_parser().parse_args(["replica", "d", "--out", "o", "--effects", "leaf_friction=2000",
+                                   "--effects", "bump_stop.gap=0.012", "frame_flex=1"])
+    assert a.effects == ["leaf_friction=2000", "bump_stop.gap=0.012", "frame_flex=1"]
+    assert build_parser().parse_args(["replica", "d", "--out", "o"]).effects == []
