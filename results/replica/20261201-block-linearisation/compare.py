@@ -22,6 +22,9 @@ from inverse.replica import (FRICTION_BLOCK_S, band_correlation, reconstruct,
 from vehicles.effects import parse_effects
 
 EFFECTS = ["leaf_friction=2000", "frame_flex=1"]
+#: the family the drives are made from and the effects added to its truth (compare_family.py sets them)
+SCENARIO = "random"
+SYNTH_EFFECTS = []
 
 
 def blocks_of(d, rep, truth, warn):
@@ -51,9 +54,9 @@ def main(cache, out, seeds):
     cache = Path(cache)
     rows = []
     for seed in seeds:
-        ds = cache / f"random-{seed}"
+        ds = cache / f"{SCENARIO}-{seed}"
         if not (ds / "truth" / "summary.json").is_file():
-            synth_command(scenario="random", seed=int(seed), out=ds, force=True)
+            synth_command(scenario=SCENARIO, seed=int(seed), out=ds, force=True, effects=SYNTH_EFFECTS)
         d = read_drive(ds)
         names = response_channels(d.channel_names)
         ch = {c: d.channels[c].to_numpy(float) for c in names}
@@ -75,7 +78,7 @@ def main(cache, out, seeds):
         print(f"seed {seed}: {sum(warned)} of {len(warned)} blocks warned; fit nrmse (median channel) old "
               f"{res['old'][2]:.3f} new {res['new'][2]:.3f}; {res['new'][1][-1] if res['new'][1] else ''}",
               flush=True)
-    lines = [f"random seeds {' '.join(map(str, seeds))}; blocks of {FRICTION_BLOCK_S} s"]
+    lines = [f"{SCENARIO} seeds {' '.join(map(str, seeds))}; blocks of {FRICTION_BLOCK_S} s"]
     for lab, sel in (("warned", True), ("unwarned", False)):
         r = [x for x in rows if x["warned"] == sel]
         if not r:
