@@ -750,6 +750,10 @@ FRICTION_BLOCK_S = 5.0
 #: one linear model, linearised on their joint samples (a damper or stiffness within ~+-9 % of a
 #: block's own changes the replica far less than the noise does; fewer pieces, fewer model switches)
 FRICTION_LEVEL_STEP = 2.0 ** 0.25
+#: the friction's equivalent damper from the measured velocity distribution, F mean|v| / mean(v^2)
+#: (True), or from its RMS through the Gaussian form F sqrt(2/pi) / RMS (False); read when called
+#: (results/replica/20261201-block-linearisation/decision_empirical.txt)
+FRICTION_EMPIRICAL = False
 #: equivalent bump-stop stiffnesses below this count as none when blocks are joined, and are not
 #: handed to the model [N/m] (0.1-0.3 % of the truck's suspension springs)
 BUMP_STOP_FLOOR = 5.0e3
@@ -934,6 +938,9 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
 
             def friction_value(k0, k1, vel=vel, pf=pf):
                 s = math.sqrt(np.mean([np.mean(np.asarray(v[k0:k1]) ** 2) for v in vel]))
+                if FRICTION_EMPIRICAL:      # E[F sign(v) v] / E[v^2] on the samples themselves
+                    a = float(np.mean([np.mean(np.abs(v[k0:k1])) for v in vel]))
+                    return pf["force"] / max(pf["velocity"], s * s / max(a, 1e-300)), s
                 return statistical_damper(pf["force"], pf["velocity"], s), s
             eqs.append(Equivalent("leaf_friction", friction_value,
                                   lambda c, pf=pf: {"force": c * pf["velocity"], "velocity": pf["velocity"]}))
