@@ -955,7 +955,8 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
             def stop_value(k0, k1, U=U, pb=pb):
                 u = U[:, k0:k1]
                 f = bump_stop_force(u, pb["gap"], pb["stiffness"], pb["smoothing"])
-                return float(np.sum(np.mean(f * u, axis=1)) / np.sum(np.mean(u * u, axis=1))), \
+                uu = float(np.sum(np.mean(u * u, axis=1)))
+                return (float(np.sum(np.mean(f * u, axis=1))) / uu if uu > 0 else 0.0), \
                     float(np.sqrt(np.mean(u * u)))
             from vehicles.effects import get_effect
             k_top = next(q.range[1] for q in get_effect("bump_stop").parameters if q.name == "stiffness")

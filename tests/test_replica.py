@@ -589,3 +589,15 @@ def test_effects_flag_repeated_accumulates():
                                    "--effects", "bump_stop.gap=0.012", "frame_flex=1"])
     assert a.effects == ["leaf_friction=2000", "bump_stop.gap=0.012", "frame_flex=1"]
     assert build_parser().parse_args(["replica", "d", "--out", "o"]).effects == []
+
+
+def test_dead_displacement_channels_give_no_bump_stop_not_a_nan():
+    """A logger whose displacement channels are all flat (dead) gives the bump stop no stiffness (none is
+    seen) and one piece -- not a nan that would split every block."""
+    from inverse.replica import replica_linear_model
+
+    fs = 200.0
+    disp = {f"susp_disp_{a}{s}": np.zeros(int(30 * fs)) for a in (1, 2, 3, 4) for s in "LR"}
+    lm, left, notes = replica_linear_model("dump_truck_8x4", {"bump_stop": {"gap": 0.01}}, disp, fs)
+    assert not hasattr(lm, "pieces") and left == [] and "equivalent stiffness 0 N/m" in notes[0]
+    assert "bump_stop" not in lm.meta["effects"]
