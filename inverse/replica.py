@@ -761,11 +761,13 @@ FRICTION_EMPIRICAL = True
 BUMP_STOP_FLOOR = 5.0e3
 
 
-def statistical_damper(force: float, velocity: float, s: float) -> float:
-    """Equivalent viscous damper [N s/m] of a Coulomb force ``force`` for a Gaussian velocity of
-    sd ``s`` (c = F sqrt(2/pi) / s, Roberts & Spanos), no stiffer than the smoothed force's own
-    slope at rest ``force / velocity``."""
-    return force / max(velocity, s * math.sqrt(math.pi / 2.0))
+def statistical_damper(force: float, velocity: float, s: float, mean_abs: float | None = None) -> float:
+    """Equivalent viscous damper [N s/m] of a Coulomb force ``force``: E[F sign(v) v] / E[v^2] =
+    F mean|v| / mean(v^2) for measured velocities of RMS ``s`` and mean magnitude ``mean_abs``; without
+    ``mean_abs``, the Gaussian form F sqrt(2/pi) / s (Roberts & Spanos).  No stiffer than the smoothed
+    force's own slope at rest ``force / velocity``."""
+    a = s * math.sqrt(2.0 / math.pi) if mean_abs is None else mean_abs
+    return force / max(velocity, s * s / max(a, 1e-300))
 
 
 def bump_stop_force(u, gap: float, stiffness: float, smoothing: float) -> np.ndarray:
@@ -941,10 +943,8 @@ def replica_linear_model(vehicle, effects, channels: dict, fs: float, t0: float 
 
             def friction_value(k0, k1, vel=vel, pf=pf):
                 s = math.sqrt(np.mean([np.mean(np.asarray(v[k0:k1]) ** 2) for v in vel]))
-                if FRICTION_EMPIRICAL:      # E[F sign(v) v] / E[v^2] on the samples themselves
-                    a = float(np.mean([np.mean(np.abs(v[k0:k1])) for v in vel]))
-                    return pf["force"] / max(pf["velocity"], s * s / max(a, 1e-300)), s
-                return statistical_damper(pf["force"], pf["velocity"], s), s
+                a = float(np.mean([np.mean(np.abs(v[k0:k1])) for v in vel])) if FRICTION_EMPIRICAL else None
+                return statistical_damper(pf["force"], pf["velocity"], s, a), s
             eqs.append(Equivalent("leaf_friction", friction_value,
                                   lambda c, pf=pf: {"force": c * pf["velocity"], "velocity": pf["velocity"]}))
     if "bump_stop" in nonlinear:
