@@ -1,6 +1,7 @@
 """Score the arms of decision.txt (this folder) from their bench_inverse results.jsonl.
 
-    python compare.py W/A W/B W/C     # each a --root of benchmarks/bench_inverse.py
+    python compare.py W/A W/B W/C     # each a --root of benchmarks/bench_inverse.py (or its results.jsonl)
+    python compare.py A-results.jsonl B-results.jsonl C-results.jsonl   # the committed copies
 
 Per arm, segments >= 3 s: G(1 cycle/m) within 20 %, class right, the 90 % coverage of ln Gq(n0) /
 w / ln G(n_best) (|error| <= 1.645 reported sd), the mean signed ln G(1 cycle/m) error and the
@@ -20,7 +21,8 @@ LN10 = math.log(10.0)     # ln(n / n0) at n = 1 cycle/m, n0 = 0.1
 
 def rows(root):
     out = {}
-    for line in Path(root, "results.jsonl").read_text().splitlines():
+    path = Path(root) if str(root).endswith(".jsonl") else Path(root, "results.jsonl")
+    for line in path.read_text().splitlines():
         r = json.loads(line)
         for i, s in enumerate(r["segments"]):
             if s["duration_s"] >= 3.0:
@@ -43,7 +45,7 @@ def score(rs):
 
 
 def main(argv):
-    arms = {Path(a).name: rows(a) for a in argv}
+    arms = {Path(a).name.replace("-results.jsonl", ""): rows(a) for a in argv}
     for name, rs in arms.items():
         s = score(rs)
         print(f"{name}: n {s['n']}, G(1) within 20 % {100 * s['g1_within20']:.1f} %, class right "
