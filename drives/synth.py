@@ -979,7 +979,7 @@ def read_truth(dataset) -> dict:
 #: must not be served as the embedded dataset).  2026-11-25: one-sided tyres.  2026-11-27:
 #: meta.toml declares the displacement zero (``susp_disp_zero``), which the diagnosis reads.
 TRUTH_MODEL_VERSION = ("2026-11-27 one-sided tyres; truth_model in the truth summary; "
-                       "susp_disp_zero declared")
+                       "susp_disp_zero declared; 2026-12-01 tyres read the road's own lines")
 
 
 def _scenario_key() -> str:

@@ -215,7 +215,9 @@ class LinearFeatures:
         between two lines sees their bilinear mix, whose power at short wavelengths,
         where neighbouring lines are little coherent, is lower (down to half midway);
         modelled exactly by letting each tyre's input be the weighted pair of lines.
-        None: each tyre on its own track.
+        None: each tyre on its own track -- what the inversion uses since 2026-12-01,
+        because its simulator's synthesised roads are read on each tyre's own line
+        (``roadlib.surface`` "Exact lines") and so is a real road.
     lam : float
         Anisotropy of the surface's lateral coherence [-].
     bias : bool

@@ -22,8 +22,9 @@ Method
   on the simulator's step grid (``dt`` = the vehicle's solver step rounded so that the
   output period is a whole number of steps), the distance travelled is the exact
   integral of the piecewise-linear speed profile (``vehicles.simulate.SpeedProfile``),
-  the height under tyre c is the road's bilinear interpolation at
-  ``(x_front0 + x_axle + s, y_c)`` and its rate the slope of the linear interpolant
+  the height under tyre c is the road's height at ``(x_front0 + x_axle + s, y_c)``
+  (``RoadSurface.height``: linear along x on the tyre's own line, roadlib.surface
+  "Exact lines") and its rate the slope of the linear interpolant
   along x times the speed.
 * Dynamics: ``x' = A x + B u`` (``LinearModel.state_space``, x = [q, q'],
   u = [z_r, z_r']) discretised with a first-order hold at the step ``dt`` and

@@ -332,8 +332,7 @@ def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
     bounds = config.bounds.for_record(fs, v_max)
     simulate = make_simulator(seg.t_bounds)
     if config.fit_model == "linear":
-        from inverse.linear_features import (CORRECTIONS_NONLINEAR, LinearFeatures, fit_hybrid, linear_model_for,
-                                             road_grid_lines)
+        from inverse.linear_features import (CORRECTIONS_NONLINEAR, LinearFeatures, fit_hybrid, linear_model_for)
 
         corrections = config.linear_corrections
         if linear_model is None:
@@ -343,10 +342,10 @@ def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
                                                       getattr(simulate, "effects", None))
             if left_out:   # offsets that depend on the road: more rounds (docs/inverse.md section 12)
                 corrections = max(corrections, CORRECTIONS_NONLINEAR)
-        # the simulator's road grid (its sinc^4 loss along x, the bilinear mix of grid lines across)
-        grid_y = road_grid_lines(simulate.width, simulate.dy) if hasattr(simulate, "width") else None
-        lin = LinearFeatures(feats, speed, linear_model, grid_dx=getattr(simulate, "dx", None), grid_y=grid_y,
-                             lam=getattr(simulate, "lam", 1.0))
+        # the simulator's road grid: its sinc^4 loss along x; across, no mix: every tyre reads the
+        # synthesised road's own line (roadlib.surface "Exact lines"), as a real road is driven
+        lin = LinearFeatures(feats, speed, linear_model, grid_dx=getattr(simulate, "dx", None),
+                             grid_y=None, lam=getattr(simulate, "lam", 1.0))
         fit = fit_hybrid(simulate, feats, params0, linear=lin, seed=stream_seed(config.seed, SEED_KEY_FIT),
                          bounds=bounds, config=config.fit, prior=prior, map_fn=map_fn, progress=progress,
                          corrections=corrections)

@@ -227,15 +227,14 @@ def linear_features_for(inv, simulate, speed):
     lin = getattr(inv.fit, "linear_features", None)
     if lin is not None:
         return lin
-    from inverse.linear_features import LinearFeatures, linear_model_for, road_grid_lines
+    from inverse.linear_features import LinearFeatures, linear_model_for
 
     if not hasattr(simulate, "vehicle"):
         raise EroadInputError("road model: the simulator has no vehicle to build the linear model from")
     lm, _ = linear_model_for(simulate.vehicle, getattr(simulate, "chassis", "rigid"),
                              getattr(simulate, "effects", None))
-    grid_y = road_grid_lines(simulate.width, simulate.dy) if hasattr(simulate, "width") else None
-    return LinearFeatures(inv.features, speed, lm, grid_dx=getattr(simulate, "dx", None), grid_y=grid_y,
-                          lam=getattr(simulate, "lam", 1.0))
+    return LinearFeatures(inv.features, speed, lm, grid_dx=getattr(simulate, "dx", None),
+                          grid_y=None, lam=getattr(simulate, "lam", 1.0))
 
 
 def _select_task(args) -> dict:

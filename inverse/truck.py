@@ -252,14 +252,26 @@ def join_sides(left, right, half_width: float = JOIN_HALF_WIDTH):
     if left.z.shape != right.z.shape or not np.array_equal(left.y, right.y):
         raise EroadInputError("join_sides: the two roads must share one grid")
     y = np.asarray(left.y, float)
-    u = np.clip((y + half_width) / (2 * half_width), 0.0, 1.0)
-    sgm = 0.5 - 0.5 * np.cos(np.pi * u)
+
+    def share(yy):
+        u = np.clip((yy + half_width) / (2 * half_width), 0.0, 1.0)
+        return 0.5 - 0.5 * np.cos(np.pi * u)
+
+    sgm = share(y)
     z = left.z * sgm[None, :] + right.z * (1.0 - sgm)[None, :]
     meta = dict(left.meta)
     meta.update({"generator": "inverse.truck.join_sides", "seed_left": left.meta.get("seed"),
                  "seed_right": right.meta.get("seed"), "join_half_width_m": float(half_width),
                  "right_meta": right.meta})
-    return RoadSurface(left.x, y, z, meta)
+    def lines(ys):   # each side's exact lines, blended as the grid is
+        a, b = left.lines(ys), right.lines(ys)
+        if a is None or b is None:
+            return None
+        w = share(np.asarray(ys, float))
+        return a * w[None, :] + b * (1.0 - w)[None, :]
+
+    exact = left.lines is not None and right.lines is not None
+    return RoadSurface(left.x, y, z, meta, lines=lines if exact else None)
 
 
 def road_from_params(params, seg_lengths, *, seed: int, width: float = SIM_WIDTH, dx: float = SIM_DX,

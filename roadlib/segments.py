@@ -242,14 +242,19 @@ def segmented_surface(segments, length: float, width: float, dx: float, dy: floa
                 f"segment {s} ({segments[s].label or 'unnamed'}) gets fewer than 2 samples of dx = {dx} m; "
                 "lengthen the road or its share")
 
-    z = np.empty((nx, ny))
-    ends = []
-    for s, (a, b) in enumerate(zip(first, last)):
-        zu, e = _unit_segment(params[s], (b - a) * dx, width, ny > 1, int(seed), s, float(x[a]),
-                              b - a + 1, y, dx)
-        g = math.sqrt(params[s].Gq_n0 / UNIT_GQ)
-        z[a:b + 1] = g * zu
-        ends.append((g * e[0], g * e[1]))
+    def pieces(yy):
+        """Every segment's rows at lateral positions ``yy`` and its exact end rows."""
+        zz = np.empty((nx, yy.size))
+        ee = []
+        for s, (a, b) in enumerate(zip(first, last)):
+            zu, e = _unit_segment(params[s], (b - a) * dx, width, ny > 1, int(seed), s, float(x[a]),
+                                  b - a + 1, yy, dx)
+            g = math.sqrt(params[s].Gq_n0 / UNIT_GQ)
+            zz[a:b + 1] = g * zu
+            ee.append((g * e[0], g * e[1]))
+        return zz, ee
+
+    z, ends = pieces(y)
 
     steps = np.abs(np.diff(z, axis=0))
     mask = np.ones(nx - 1, bool)
@@ -258,6 +263,7 @@ def segmented_surface(segments, length: float, width: float, dx: float, dy: floa
 
     sy = PATCH_SY_OVER_DY * dy
     junctions = []
+    patches = []
     for j, c in enumerate(cut):
         xj = x[c] + 0.5 * dx
         d = ends[j + 1][0] - ends[j][1]    # both exact at x_j (right field's start, left's end)
@@ -275,6 +281,7 @@ def segmented_surface(segments, length: float, width: float, dx: float, dy: floa
         lat = 0.5 * d if ny == 1 else np.exp(
             -0.5 * ((y[:, None] - y[None, :]) / sy) ** 2) @ a_lat
         z[lo:hi] += (sign * _window(u, sx))[:, None] * lat[None, :]
+        patches.append((lo, hi, sign * _window(u, sx)))
         junctions.append({"x": float(xj), "sx": float(sx), "n_j": float(1.0 / (4 * PATCH_SUPPORT * sx)),
                           "sy": float(sy), "sx_capped": bool(sx_need > sx_cap),
                           "max_offset_removed": float(np.max(np.abs(d)))})
@@ -291,4 +298,27 @@ def segmented_surface(segments, length: float, width: float, dx: float, dy: floa
         "median_step": med_step,
         "dx": float(dx), "dy": float(dy),
     }
-    return RoadSurface(x, y, z, meta)
+
+    def lines(ys):
+        """The road itself at lateral positions ``ys``: each segment's field evaluated there,
+        each junction's step removed on that line by the same window (the grid's patch is the
+        lateral interpolant of these steps; on a grid line the two agree)."""
+        yy = np.asarray(ys, float)
+        zz, ee = pieces(yy)
+        for j, (lo, hi, win) in enumerate(patches):
+            zz[lo:hi] += win[:, None] * (0.5 * (ee[j + 1][0] - ee[j][1]))[None, :]
+        return zz
+
+    return RoadSurface(x, y, z, meta, lines=lines if ny > 1 else None)
+
+
+def regenerate_segmented(meta: dict, x, y):
+    """The road a ``segmented_surface`` metadata describes, on the grid ``x``, ``y`` of its
+    file (for :class:`roadlib.surface.RoadSurface`'s exact lines after loading)."""
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    keys = ("Gq_n0", "share", "w", "nmin", "nmax", "lam", "label", "w2", "n_break")
+    segs = [RoadSegment(**{k: d[k] for k in keys if k in d}) for d in meta["segments"]]
+    width = float(y[-1] - y[0])
+    return segmented_surface(segs, float(x[-1] - x[0]), width, float(meta["dx"]), float(meta["dy"]),
+                             seed=int(meta["seed"]), x0=float(x[0]))

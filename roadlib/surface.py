@@ -9,6 +9,17 @@ wheel tracks at lateral offsets (dual tyres too), tyre-footprint filtering,
 Conventions: ``x`` [m] along travel, ``y`` [m] lateral (positive left, 0 on the
 centre line), ``z`` [m] up, array shape (nx, ny).
 
+Exact lines: a synthesised road (``roadlib.segments.segmented_surface``,
+``roadlib.synthesis.synth_surface``) is a continuous field stored on the grid.  Read
+between two grid lines, a bilinear interpolation mixes two partly coherent lines and
+loses short-wave power (a tyre midway between lines 0.1 m apart sees 0.76 of the
+road's PSD at 2 cycles/m).  Such a surface carries ``lines``, a callable that evaluates
+the field itself at any lateral positions on the grid x; :meth:`height`,
+:meth:`track` and :meth:`tracks` use it, so every simulator reads a tyre's own line.
+The grid is still what is stored, plotted and exported; a road file made by those
+generators gets its ``lines`` back when loaded (regenerated from its metadata and
+checked against the stored grid).
+
 File formats
 ------------
 ``.npz``: arrays ``x`` (nx,) [m], ``y`` (ny,) [m], ``z`` (nx, ny) [m] float64, and
@@ -39,6 +50,12 @@ import numpy as np
 
 from eroad.errors import EroadInputError
 
+#: at most this many distinct lateral positions are read exactly at once (a vehicle's tyre
+#: lines; a query with more, e.g. a whole grid, is read bilinearly)
+MAX_EXACT_LINES = 64
+#: exact line sets kept per surface (a drive asks for one set, its vehicle's tyres)
+LINE_CACHE_SIZE = 4
+
 #: prefix of the $CT comment lines that carry our metadata in .crg files
 CRG_META_PREFIX = "eroad-meta:"
 _CRG_CHUNK = 72 - len(CRG_META_PREFIX) - 1  # CRG header lines are <= 72 characters
@@ -55,12 +72,19 @@ class RoadSurface:
     z : (nx, ny) array, m
     meta : dict, free metadata (generator parameters, seed, ...); JSON-serialisable
         to be saved
+    lines : callable, optional
+        ``lines(ys) -> (nx, len(ys))``: the surface's exact heights at lateral positions
+        ``ys`` on the grid x (module docstring, "Exact lines"); not saved (a loaded file
+        of a known generator gets it back); may return None to decline.
     """
 
     x: np.ndarray
     y: np.ndarray
     z: np.ndarray
     meta: dict = field(default_factory=dict)
+    #: optional exact lateral reading: ``lines(ys) -> (nx, len(ys))`` heights [m] on the grid
+    #: x at lateral positions ``ys`` [m] (module docstring); None: bilinear in y
+    lines: object = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         self.x = np.asarray(self.x, dtype=float)
@@ -142,12 +166,43 @@ class RoadSurface:
         if self.y.size == 1:
             z = self.z[:, 0]
             return (1 - tx) * z[ix] + tx * z[ix + 1]
+        exact = self._exact_lines(yq)
+        if exact is not None:   # the field itself at each query's lateral position, linear in x
+            uy, lines = exact
+            j = np.searchsorted(uy, np.clip(yq, self.y[0], self.y[-1]))
+            return (1 - tx) * lines[ix, j] + tx * lines[ix + 1, j]
         fy = np.clip((yq - self.y[0]) / self.dy, 0.0, self.y.size - 1.0)
         iy = np.minimum(fy.astype(np.intp), self.y.size - 2)
         ty = fy - iy
         z = self.z
         return ((1 - tx) * (1 - ty) * z[ix, iy] + tx * (1 - ty) * z[ix + 1, iy]
                 + (1 - tx) * ty * z[ix, iy + 1] + tx * ty * z[ix + 1, iy + 1])
+
+    def _exact_lines(self, yq):
+        """(sorted distinct lateral positions, their exact lines (nx, m)) of the queries
+        ``yq`` (clamped to the grid's width), or None where the surface has no ``lines`` or
+        the queries hold more than ``MAX_EXACT_LINES`` distinct positions."""
+        if self.lines is None:
+            return None
+        uy = np.unique(np.clip(yq, self.y[0], self.y[-1]))
+        if uy.size > MAX_EXACT_LINES:
+            return None
+        key = uy.tobytes()
+        cache = self.__dict__.setdefault("_line_cache", {})
+        hit = cache.get(key)
+        if hit is None:
+            hit = self.lines(uy)
+            if hit is None:          # a source that declined (e.g. a file's grid it cannot rebuild)
+                self.lines = None
+                return None
+            hit = np.asarray(hit, float)
+            if hit.shape != (self.x.size, uy.size):
+                raise ValueError(f"RoadSurface.lines returned shape {hit.shape}, expected "
+                                 f"{(self.x.size, uy.size)}")
+            while len(cache) >= LINE_CACHE_SIZE:
+                cache.pop(next(iter(cache)))
+            cache[key] = hit
+        return uy, hit
 
     def track(self, y: float, x=None) -> np.ndarray:
         """Profile z along ``x`` (default: the grid x) at lateral position ``y`` [m].
@@ -203,10 +258,15 @@ class RoadSurface:
         n = max(1, int(round(length / self.dx)))
         if n % 2 == 0:
             n += 1
-        z = uniform_filter1d(self.z, size=n, axis=0, mode="nearest") if n > 1 else self.z.copy()
+        def smooth(a):
+            return uniform_filter1d(a, size=n, axis=0, mode="nearest") if n > 1 else np.array(a, float)
+
+        z = smooth(self.z)
         meta = dict(self.meta)
         meta["footprint_length"] = n * self.dx
-        return RoadSurface(self.x.copy(), self.y.copy(), z, meta)
+        src = self.lines
+        lines = None if src is None else (lambda ys: None if (a := src(ys)) is None else smooth(a))
+        return RoadSurface(self.x.copy(), self.y.copy(), z, meta, lines=lines)
 
     def summary(self) -> dict:
         """Small JSON-ready description (sizes [m], grid, RMS height [m])."""
@@ -287,9 +347,13 @@ class RoadSurface:
                 raise EroadInputError(f"{path}: not a readable .npz road file ({exc})") from None
             if z.ndim == 1:
                 z = z[:, None]
-            return cls(x, y, z, meta)
+            out = cls(x, y, z, meta)
+            out.lines = _lines_from_meta(out)
+            return out
         if suffix == ".crg":
-            return cls._read_crg(path)
+            out = cls._read_crg(path)
+            out.lines = _lines_from_meta(out)
+            return out
         raise EroadInputError(f"{path}: unknown road file type {path.suffix!r}; use .npz or .crg"
                               + (" (a measured profile, x [m] z [m]? `eroad road from-profile "
                                  f"{path.name} --out road.npz` makes a road of it)"
@@ -343,6 +407,42 @@ class RoadSurface:
             z = z[:, :1]
             y = np.array([single])
         return cls(x, y, z, meta)
+
+
+def _lines_from_meta(surface: "RoadSurface"):
+    """The exact-line source of a loaded road file whose metadata names a generator that
+    can rebuild it (``roadlib.segments.segmented_surface``, ``roadlib.synthesis.
+    synth_surface``), or None.  Lazy: the road is regenerated at the first exact read and
+    compared with the stored grid; a grid that differs (edited, filtered, written by an
+    older generator) keeps the bilinear reading."""
+    if surface.y.size < 2:
+        return None
+    gen = surface.meta.get("generator")
+    if gen == "roadlib.segments.segmented_surface":
+        from roadlib.segments import regenerate_segmented
+        rebuild = regenerate_segmented
+    elif gen == "roadlib.synthesis.synth_surface":
+        from roadlib.synthesis import regenerate_surface
+        rebuild = regenerate_surface
+    else:
+        return None
+    state = {}
+
+    def lines(ys):
+        if "src" not in state:
+            state["src"] = None
+            try:
+                again = rebuild(surface.meta, surface.x, surface.y)
+            except (EroadInputError, KeyError, TypeError, ValueError):
+                again = None
+            if again is not None and again.z.shape == surface.z.shape:
+                scale = max(float(np.max(np.abs(surface.z))), 1e-12)
+                # npz keeps float64 exactly; a .crg's float32 grid agrees to ~1e-7 of the range
+                if float(np.max(np.abs(again.z - surface.z))) <= 1e-6 * scale:
+                    state["src"] = again.lines
+        return None if state["src"] is None else state["src"](ys)
+
+    return lines
 
 
 def _json_default(o):

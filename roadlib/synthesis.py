@@ -493,7 +493,23 @@ def synth_surface(params: SpectralParams, length: float, width: float, seed=0,
             "seed": _seed_repr(seed), "n_harmonics": field.n_harmonics,
             "period_x_m": field.n_fft * params.dx}
     info.update(meta or {})
-    return RoadSurface(x, y, z, info)
+
+    def lines(ys):   # the field itself at lateral positions ys (RoadSurface "Exact lines")
+        return field.grid(x0, nx, np.asarray(ys, float))
+
+    return RoadSurface(x, y, z, info, lines=lines if y.size > 1 else None)
+
+
+def regenerate_surface(meta: dict, x, y):
+    """The road a ``synth_surface`` metadata describes, on the grid of its file (for
+    :class:`roadlib.surface.RoadSurface`'s exact lines after loading); None where the
+    seed is not a plain integer."""
+    seed = meta.get("seed")
+    if not isinstance(seed, int):
+        return None
+    params = SpectralParams(**meta["params"])
+    x = np.asarray(x, float)
+    return synth_surface(params, float(x[-1] - x[0]), float(y[-1] - y[0]), seed=seed, x0=float(x[0]))
 
 
 def _seed_repr(seed):

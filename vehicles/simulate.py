@@ -7,7 +7,7 @@ simulator the virtual test drive, the inverse fit and the gap diagnosis call, ma
 times, so it is built for speed:
 
 * the road height and slope under every tyre are computed for the whole time grid
-  at once (bilinear interpolation, vectorised) and turned into the generalised road
+  at once (each tyre's own line, linear in x, vectorised) and turned into the generalised road
   forces on the axle nodes (see :mod:`vehicles.builder`);
 * one Python ``PreStep`` callback per step only indexes that array and sets the
   road forces with one call; everything else runs in Exudyn's C++;
@@ -180,8 +180,8 @@ def _speed_profile(speed, duration) -> SpeedProfile:
 def road_under_tyres(road, model, x_start, y_offset, s, v):
     """Road height and its time derivative under every tyre.
 
-    Bilinear interpolation of the surface, done as: the profile of each tyre's track
-    at the road's grid x (interpolated in y), then linear interpolation in x (the
+    The profile of each tyre's track at the road's grid x (the road's own line where the
+    surface has exact lines, else interpolated in y), then linear interpolation in x (the
     same numbers as ``road.height``, and the exact slope of the interpolant).
 
     Parameters
@@ -208,8 +208,11 @@ def road_under_tyres(road, model, x_start, y_offset, s, v):
     z_t = np.empty_like(z)
     gx = road.x
     dx = road.dx
+    # every tyre's track at once (a synthesised road evaluates its field at each tyre's own
+    # lateral position, roadlib.surface "Exact lines"; any other road is bilinear in y)
+    tracks = road.tracks([y_offset + ct.y for ct in model.contacts])
     for c, ct in enumerate(model.contacts):
-        track = road.track(y_offset + ct.y)
+        track = tracks[c]
         xq = x_start + vp.axles[ct.axle].x + s
         z[:, c] = np.interp(xq, gx, track)
         i = np.clip(((xq - gx[0]) / dx).astype(np.intp), 0, gx.size - 2)
