@@ -178,6 +178,16 @@ class RoadSurface:
         return ((1 - tx) * (1 - ty) * z[ix, iy] + tx * (1 - ty) * z[ix + 1, iy]
                 + (1 - tx) * ty * z[ix, iy + 1] + tx * ty * z[ix + 1, iy + 1])
 
+    def __getstate__(self):
+        """Pickled without ``lines`` (a closure over the generator) and its cache; unpickled,
+        a road of a known generator gets its lines back as a loaded file does (Dask and
+        process pools move roads between processes)."""
+        return {k: v for k, v in self.__dict__.items() if k not in ("lines", "_line_cache")}
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self.lines = _lines_from_meta(self)
+
     def _exact_lines(self, yq):
         """(sorted distinct lateral positions, their exact lines (nx, m)) of the queries
         ``yq`` (clamped to the grid's width), or None where the surface has no ``lines`` or
@@ -188,7 +198,10 @@ class RoadSurface:
         if uy.size > MAX_EXACT_LINES:
             return None
         key = uy.tobytes()
-        cache = self.__dict__.setdefault("_line_cache", {})
+        owner, cache = self.__dict__.get("_line_cache", (None, None))
+        if owner is not self.lines:          # a new source: what was cached came from another
+            cache = {}
+            self.__dict__["_line_cache"] = (self.lines, cache)
         hit = cache.get(key)
         if hit is None:
             hit = self.lines(uy)

@@ -143,3 +143,15 @@ def test_the_simulator_reads_each_tyres_own_line():
         xq = 20.0 + model.vp.axles[ct.axle].x + s
         line = road.lines(np.array([ct.y]))[:, 0]
         assert np.allclose(z[:, c], np.interp(xq, road.x, line), rtol=0, atol=1e-12)
+
+
+def test_a_pickled_road_keeps_its_lines():
+    """Process pools and Dask move roads by pickle; the closure is not pickled, the lines come back
+    from the metadata as for a loaded file."""
+    import pickle
+
+    segs = [RoadSegment.from_class("C", 30), RoadSegment.from_class("B", 30)]
+    road = segmented_surface(segs, 60.0, 3.0, 0.05, 0.1, seed=6)
+    back = pickle.loads(pickle.dumps(road))
+    assert np.max(np.abs(back.tracks(TYRES) - road.tracks(TYRES))) < 1e-10 * np.ptp(road.z)
+    assert np.array_equal(back.z, road.z)
