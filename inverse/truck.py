@@ -263,6 +263,7 @@ def join_sides(left, right, half_width: float = JOIN_HALF_WIDTH):
     meta.update({"generator": "inverse.truck.join_sides", "seed_left": left.meta.get("seed"),
                  "seed_right": right.meta.get("seed"), "join_half_width_m": float(half_width),
                  "right_meta": right.meta})
+
     def lines(ys):   # each side's exact lines, blended as the grid is
         a, b = left.lines(ys), right.lines(ys)
         if a is None or b is None:
