@@ -194,6 +194,31 @@ def linear_model_for(vehicle, chassis: str = "rigid", effects=None):
     return linear_model(load_vehicle(vehicle), chassis, effects=keep or None), sorted(nonlinear)
 
 
+def features_for_simulator(features, speed, simulate, linear_model=None,
+                           what: str = "linear fit: needs a linear model or a simulator with a vehicle") -> tuple:
+    """The LinearFeatures a linear fit works on when its time simulations run on ``simulate``
+    (an ``inverse.truck`` simulator): the simulator's vehicle, chassis and LINEAR effects
+    (:func:`linear_model_for`) unless ``linear_model`` is given, its road grid's sinc^4 loss
+    along x (``simulate.dx``), no lateral mix (every tyre reads the synthesised road's own
+    line, ``roadlib.surface`` "Exact lines", as a real road is driven), its ``lam``; no offsets.
+    ``what``: the one-line refusal when there is neither a model nor a vehicle.
+
+    Returns
+    -------
+    (LinearFeatures, list of str) : the features and the nonlinear effects the linear model
+    leaves out (empty when ``linear_model`` was given).
+    """
+    left_out = []
+    if linear_model is None:
+        if not hasattr(simulate, "vehicle"):
+            raise EroadInputError(what)
+        linear_model, left_out = linear_model_for(simulate.vehicle, getattr(simulate, "chassis", "rigid"),
+                                                  getattr(simulate, "effects", None))
+    lin = LinearFeatures(features, speed, linear_model, grid_dx=getattr(simulate, "dx", None),
+                         grid_y=None, lam=getattr(simulate, "lam", 1.0))
+    return lin, left_out
+
+
 class LinearFeatures:
     """``features_fn(params, seed) -> list of K feature arrays`` from the linear model.
 

@@ -332,20 +332,14 @@ def invert(time, channels: dict, speed, make_simulator, *, predict_rms=None,
     bounds = config.bounds.for_record(fs, v_max)
     simulate = make_simulator(seg.t_bounds)
     if config.fit_model == "linear":
-        from inverse.linear_features import (CORRECTIONS_NONLINEAR, LinearFeatures, fit_hybrid, linear_model_for)
+        from inverse.linear_features import CORRECTIONS_NONLINEAR, features_for_simulator, fit_hybrid
 
+        lin, left_out = features_for_simulator(
+            feats, speed, simulate, linear_model,
+            "invert: fit_model 'linear' needs linear_model= or a simulator with a vehicle")
         corrections = config.linear_corrections
-        if linear_model is None:
-            if not hasattr(simulate, "vehicle"):
-                raise EroadInputError("invert: fit_model 'linear' needs linear_model= or a simulator with a vehicle")
-            linear_model, left_out = linear_model_for(simulate.vehicle, getattr(simulate, "chassis", "rigid"),
-                                                      getattr(simulate, "effects", None))
-            if left_out:   # offsets that depend on the road: more rounds (docs/inverse.md section 12)
-                corrections = max(corrections, CORRECTIONS_NONLINEAR)
-        # the simulator's road grid: its sinc^4 loss along x; across, no mix: every tyre reads the
-        # synthesised road's own line (roadlib.surface "Exact lines"), as a real road is driven
-        lin = LinearFeatures(feats, speed, linear_model, grid_dx=getattr(simulate, "dx", None),
-                             grid_y=None, lam=getattr(simulate, "lam", 1.0))
+        if left_out:   # offsets that depend on the road: more rounds (docs/inverse.md section 12)
+            corrections = max(corrections, CORRECTIONS_NONLINEAR)
         fit = fit_hybrid(simulate, feats, params0, linear=lin, seed=stream_seed(config.seed, SEED_KEY_FIT),
                          bounds=bounds, config=config.fit, prior=prior, map_fn=map_fn, progress=progress,
                          corrections=corrections)

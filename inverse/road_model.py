@@ -227,14 +227,10 @@ def linear_features_for(inv, simulate, speed):
     lin = getattr(inv.fit, "linear_features", None)
     if lin is not None:
         return lin
-    from inverse.linear_features import LinearFeatures, linear_model_for
+    from inverse.linear_features import features_for_simulator
 
-    if not hasattr(simulate, "vehicle"):
-        raise EroadInputError("road model: the simulator has no vehicle to build the linear model from")
-    lm, _ = linear_model_for(simulate.vehicle, getattr(simulate, "chassis", "rigid"),
-                             getattr(simulate, "effects", None))
-    return LinearFeatures(inv.features, speed, lm, grid_dx=getattr(simulate, "dx", None),
-                          grid_y=None, lam=getattr(simulate, "lam", 1.0))
+    return features_for_simulator(inv.features, speed, simulate, None,
+                                  "road model: the simulator has no vehicle to build the linear model from")[0]
 
 
 def _select_task(args) -> dict:

@@ -478,7 +478,6 @@ def segment(time, channels, speed, *, k=None, k_max: int | None = None, window_s
     logr = np.mean([np.log(np.maximum(local_rms(x, fs, window_s), 1e-300)) for x in filt], axis=0)
     step = max(1, int(round(fs / rate_hz)))
     nb = t.size // step
-    ty = t[: nb * step].reshape(nb, step).mean(axis=1)
     e = (w_init - 1.0) if speed_exponent is None else float(speed_exponent)
     vnorm = (np.maximum(v, 1e-3) / max(float(np.mean(v)), 1e-3)) ** e
     duration = t[-1] - t[0] + 1.0 / fs

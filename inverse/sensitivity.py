@@ -422,8 +422,6 @@ class _TrustRegionQP:
         self.min_gap = min_gap
 
     def solve(self, Q, b, theta, prior, pw, lbd, ubd):
-        import casadi as ca
-
         K = self.K
         p = np.concatenate([np.concatenate([Qk.T.ravel() for Qk in Q]), np.ravel(b), np.ravel(theta),
                             np.ravel(prior), np.ravel(pw)])
