@@ -1417,7 +1417,10 @@ def run_replica(dataset, out, *, effects=None, noise_sd=None, holdout="auto", fo
             "lines": {"layout": rep.operator.lines,
                       "tyre_lines": [{"side": side, "y_m": float(yl), "column": line_column(side, yl)}
                                      for side, yl, _ in rep.lines] if rep.operator.lines == "tyre" else [],
-                      "tracks": "z_left_m / z_right_m: the common profile of each side's tyre lines"
+                      "tracks": ("z_left_m / z_right_m: the mean of the road under each side's tyres (a dual "
+                                 "pair counted twice), inverse.replica.side_tracks"),
+                      "accuracy": ("per line at short waves see docs/replica.md 'Line by line': the two "
+                                   "lines of a dual pair are told apart by the prior, not the data")
                                 if rep.operator.lines == "tyre" else "one profile per side for all its tyres",
                       "lateral_field": {"method": "linear between lines, held beyond (conditional mean)",
                                         "sd_at_0.5m_from_a_line_m": float(math.sqrt(0.5 / (rep.alpha * dx)))}},
