@@ -112,6 +112,41 @@ def effects_from_diagnosis(summary: dict, action: str = "inverted") -> tuple[dic
 CLOSEST_SHARE_MIN = 0.6
 
 
+#: the loop's leaf-friction force from the body's force balance (:mod:`diagnosis.force_balance`,
+#: no road) instead of the diagnosis's calibrated value, where the balance is available and
+#: detects friction.  Stated and tested at stop 74 (results/diagnosis_blind/20261201-force-balance/)
+FRICTION_FROM_BALANCE = True
+
+
+def friction_from_balance(effects: dict | None, reason: str, dataset) -> tuple[dict | None, str, dict | None]:
+    """Where the effects to invert with hold a leaf friction: its force from the body's force
+    balance, road-independent, where the diagnosis's calibration went through a fitted road
+    (its value scatters by about 0.25 in ln, docs/inverse.md).  Kept as calibrated where the
+    balance is not available (channels missing, a poor balance) or does not see friction.
+
+    Returns ``(effects, reason, balance)``: the effects (a copy when changed), the reason line
+    with what was done, the balance's result (None where no leaf friction is used).
+    """
+    if not FRICTION_FROM_BALANCE or not effects or "leaf_friction" not in effects:
+        return effects, reason, None
+    from diagnosis.force_balance import describe, leaf_friction
+    from drives.format import read_drive
+
+    fb = leaf_friction(read_drive(dataset))
+    old = effects["leaf_friction"].get("force")
+    if not fb.get("available"):
+        return effects, f"{reason}; {describe(fb)}: the calibrated force kept", fb
+    if not fb["detected"]:
+        return effects, (f"{reason}; the body's force balance does not see the friction ({fb['force_N']:.0f} N, "
+                         f"sd {fb['sd_N']:.0f} N): the calibrated force kept"), fb
+    new = {k: dict(v) for k, v in effects.items()}
+    new["leaf_friction"]["force"] = float(fb["force_N"])
+    lo, hi = fb["interval_90_N"]
+    was = f"; the diagnosis's calibration gave {old:.0f} N" if isinstance(old, (int, float)) else ""
+    return new, (f"{reason.replace(_describe(effects), _describe(new))} (the friction force from the body's "
+                 f"force balance, no road needed: 90 % {max(lo, 0):.0f}-{hi:.0f} N{was})"), fb
+
+
 def closest_vehicle_effect(summary: dict) -> tuple[dict, float] | None:
     """An ``unexplained`` verdict's closest library effect, when the loop corrects with it.
 
@@ -347,6 +382,7 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
     try:
         dsum = _diagnosis_summary(dataset, work, diagnosis, True, workers, quick, seed, progress, out)
         effects, reason = effects_from_diagnosis(dsum)
+        effects, reason, balance = friction_from_balance(effects, reason, dataset)
         from drives.format import read_drive
         inversion["channels"], why = loop_channels(loop_verdict(dsum), inversion.get("channels"),
                                                    read_drive(dataset).channel_names)
@@ -380,6 +416,7 @@ def invert_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick: 
             "model_form": chosen.get("fit", {}).get("model_form"),
             "channel_set": chosen.get("fit", {}).get("channel_set"),
             "diagnosis": "diagnose/summary.json",
+            "force_balance": balance,
             "nominal_segments": nominal["segments"] if effects else None,
             "nominal_fit_quality": nominal.get("fit_quality") if effects else None}
         write_table(compare_table(nominal["segments"], chosen["segments"] if effects else []),

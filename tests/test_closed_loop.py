@@ -105,7 +105,15 @@ def test_run_folder_with_a_given_diagnosis(tmp_path, confidence, form):
     run = tmp_path / "run"
     s = invert_closed_loop(ds, run, workers=1, seed=0, diagnosis=diag, progress=lambda m: None,
                            segments=1, max_iter=2, candidates=1)
-    assert s["closed_loop"]["corrected"] and s["closed_loop"]["effects"] == {"leaf_friction": {"force": 2200.0}}
+    assert s["closed_loop"]["corrected"] and list(s["closed_loop"]["effects"]) == ["leaf_friction"]
+    used = s["closed_loop"]["effects"]["leaf_friction"]["force"]
+    from diagnosis import closed_loop
+
+    if closed_loop.FRICTION_FROM_BALANCE:   # the body's force balance replaces the calibrated 2200 N
+        fb = s["closed_loop"]["force_balance"]
+        assert used == fb["force_N"] and abs(used / 2000.0 - 1.0) < 0.2     # the `random` truth: 2000 N
+    else:
+        assert used == 2200.0
     assert s["closed_loop"]["model_form"] == form and s["fit"]["model_form"] == form
     for f in ("summary.json", "config.toml", "road.npz", "nominal/summary.json", "diagnose/report.md",
               "tables/table1_nominal_vs_corrected.md", "tables/table1.md"):
