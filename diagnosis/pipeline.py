@@ -1131,6 +1131,10 @@ def diagnose(dataset, out, *, vehicle=None, effects=None, workers: int = 2, quic
     timing["total_s"] = _time.perf_counter() - wall0
 
     meta = make_meta(model, ps, refit, joint)
+    # a measurement beside the verdict, no road needed (it changes no verdict)
+    from diagnosis.force_balance import describe, leaf_friction
+    meta["force_balance"] = leaf_friction(drive, vp)
+    progress(describe(meta["force_balance"]))
     write_report(out, **_report_args(ps), meta=meta, force=force)
     write_run_json(out, finish_run_info(record, "complete", wall_s=_time.perf_counter() - wall0))
     summary = json.loads((out / "summary.json").read_text())

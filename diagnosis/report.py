@@ -502,6 +502,12 @@ def render_markdown(summary: Mapping, figures: Mapping[str, str]) -> str:
     static = _static_offset_text(summary)
     if static:
         L.append(static + "\n")
+    if meta.get("force_balance"):
+        from diagnosis.force_balance import describe
+
+        L.append("## Measured without a road\n")
+        L.append(describe(meta["force_balance"]) + ". The body's heave and pitch balance with the nominal "
+                 "spring and damper rates (diagnosis/force_balance.py); it does not enter the verdict.\n")
     D = summary.get("verdict_detail")
     if D and D.get("residual"):
         R = D["residual"]
