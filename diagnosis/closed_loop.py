@@ -91,6 +91,9 @@ def effects_from_diagnosis(summary: dict, action: str = "inverted") -> tuple[dic
                       f"({', '.join(map(str, edge))}): the value is a bound, not an estimate, so the "
                       f"nominal model is kept")
     params = _ranking_parameters(summary, verdict)
+    fb = (summary.get("meta") or {}).get("force_balance") or {}
+    if params is None and detail.get("named_on") == "force_balance" and fb.get("available"):
+        params = {"leaf_friction": {"force": float(fb["force_N"])}}
     if params is None:
         return None, f"the diagnosis named {verdict} but recorded no calibrated parameters: nominal model kept"
     text = _describe(params)

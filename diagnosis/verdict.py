@@ -886,7 +886,45 @@ def _signature_distance(single: Mapping | None, two: Mapping | None, method: str
     return None
 
 
+#: name a leaf friction that the body's force balance measures (:mod:`diagnosis.force_balance`,
+#: read before the verdict into ``meta.force_balance``): a direct measurement of the effect's own
+#: force, with no road in it, so a stronger road-independent signature than any band ratio.  It
+#: names what the gap-based rules left as ``none``, ``unexplained`` or another effect -- the
+#: independent truck's frictions whose calibrated model closed only a quarter of a gap its other
+#: differences make (docs/diagnosis.md).  Never "clear": the gap's share is not asked.  Stated and
+#: tested at stop 74 (results/diagnosis_blind/20261201-force-balance/).
+FORCE_BALANCE_NAMES = True
+#: least force [N] the balance must read to name a friction: the blind strengths' weak end is
+#: 500 N (diagnosis.blind.STRENGTHS); on drives without friction the balance read -552..+157 N on
+#: both trucks (development drives and test 2 of stop 74, 36 drives), 157 N the only one detected
+FORCE_BALANCE_F_MIN = 300.0
+
+
 def decide(summary: Mapping, *, tie_break: bool = _SETTING, **kw) -> dict:
+    """:func:`decide_gap`, then :func:`force_balance_view`."""
+    return force_balance_view(decide_gap(summary, tie_break=tie_break, **kw), summary)
+
+
+def force_balance_view(d: dict, summary: Mapping, names: bool = _SETTING, f_min: float = _SETTING) -> dict:
+    """The decision ``d`` with a leaf friction the force balance measures named (see
+    :data:`FORCE_BALANCE_NAMES`); unchanged where the summary has no available balance."""
+    names, f_min = _or_setting(names, FORCE_BALANCE_NAMES), _or_setting(f_min, FORCE_BALANCE_F_MIN)
+    fb = (summary.get("meta") or {}).get("force_balance") or {}
+    if not (names and fb.get("available") and fb.get("detected")) or d.get("verdict") == "leaf_friction":
+        return d
+    if float(fb.get("force_N", 0.0)) < f_min:
+        return d
+    lo, hi = fb["interval_90_N"]
+    before = {k: d.get(k) for k in ("verdict", "confidence", "reason")}
+    was = (f"the gap-based rules answered {before['verdict']} ({before['confidence']}): {before['reason']}"
+           if before["verdict"] else "")
+    return dict(d, verdict="leaf_friction", confidence="ambiguous", identified=False, edge=[],
+                named_on="force_balance", before_force_balance=before,
+                reason=(f"the body's own force balance measures a leaf friction of {fb['force_N']:.0f} N per "
+                        f"spring (90 % {max(lo, 0.0):.0f}-{hi:.0f} N) without any road; {was}"))
+
+
+def decide_gap(summary: Mapping, *, tie_break: bool = _SETTING, **kw) -> dict:
     """Verdict, confidence, reason and what is left, from a diagnosis summary: see
     :func:`decide_one` for the rules and the keywords.
 

@@ -91,3 +91,30 @@ def test_closed_loop_takes_the_balance_force(drives, monkeypatch):
     assert closed_loop.friction_from_balance({"payload": {"mass": 1.0}}, "r", drives["ours"])[2] is None
     monkeypatch.setattr(closed_loop, "FRICTION_FROM_BALANCE", False)
     assert closed_loop.friction_from_balance(eff, why, drives["ours"]) == (eff, why, None)
+
+
+def test_verdict_names_a_friction_the_balance_measures():
+    """verdict.force_balance_view: a detected friction of at least FORCE_BALANCE_F_MIN turns a
+    gap-based none / unexplained / other name into leaf_friction, 'ambiguous', saying what the
+    gap-based rules answered; below the floor, undetected, unavailable or with the rule off the
+    decision stands; an existing leaf_friction verdict is left as it is."""
+    from diagnosis import verdict
+
+    d0 = {"verdict": "none", "confidence": "none", "reason": "no gap beyond noise"}
+    fb = {"available": True, "detected": True, "force_N": 800.0, "interval_90_N": [600.0, 1000.0]}
+    s = {"meta": {"force_balance": fb}}
+    d = verdict.force_balance_view(d0, s)
+    assert d["verdict"] == "leaf_friction" and d["confidence"] == "ambiguous" and d["named_on"] == "force_balance"
+    assert "800 N" in d["reason"] and "answered none" in d["reason"] and d["before_force_balance"]["verdict"] == "none"
+    assert verdict.force_balance_view(d0, {"meta": {"force_balance": dict(fb, force_N=200.0)}}) is d0
+    assert verdict.force_balance_view(d0, {"meta": {"force_balance": dict(fb, detected=False)}}) is d0
+    assert verdict.force_balance_view(d0, {"meta": {"force_balance": dict(fb, available=False)}}) is d0
+    assert verdict.force_balance_view(d0, {}) is d0
+    assert verdict.force_balance_view(d0, s, names=False) is d0
+    lf = {"verdict": "leaf_friction", "confidence": "clear", "reason": "r"}
+    assert verdict.force_balance_view(lf, s) is lf
+    # the closed loop inverts with the balance's force where the ranking holds no friction entry
+    eff, reason = closed_loop.effects_from_diagnosis(
+        {"verdict": "leaf_friction", "verdict_confidence": "ambiguous", "meta": {"force_balance": fb},
+         "verdict_detail": {"named_on": "force_balance", "edge": []}, "ranking": []})
+    assert eff == {"leaf_friction": {"force": 800.0}}
