@@ -458,6 +458,9 @@ def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick:
     try:
         dsum = _diagnosis_summary(dataset, work, diagnosis, copy_diagnosis, workers, quick, seed, progress, out)
         effects, reason = effects_from_diagnosis(dsum, action="reconstructed")
+        # one friction value per drive in a run: the inversion's (measured for the inversion, stop 74;
+        # not benchmarked on the replica separately)
+        effects, reason, balance = friction_from_balance(effects, reason, dataset)
         progress(f"closed loop: {reason}")
         summary = run_replica(dataset, work / "replica", effects=effects, argv=argv, progress=progress, **replica)
         main = work / "replica"
@@ -469,7 +472,7 @@ def replica_closed_loop(dataset, out, *, workers: int = 2, seed: int = 0, quick:
             where = os.path.relpath(Path(diagnosis).resolve() / "summary.json", out.resolve())
         summary["closed_loop"] = {"verdict": dsum.get("verdict"), "confidence": dsum.get("verdict_confidence"),
                                   "effects": effects or {}, "corrected": bool(effects), "reason": reason,
-                                  "diagnosis": where}
+                                  "diagnosis": where, "force_balance": balance}
         from inverse.run import dataset_path
         summary["dataset"]["path"] = dataset_path(dataset, out)      # as recorded from the final folder
         write_json_atomic(main / "summary.json", summary)
